@@ -1,0 +1,27 @@
+// Compatibility layer between this project and Debian's LAMMPS 29 Sep 2021 headers.
+//
+// 1. fmt: Debian's liblammps-dev omits the fmt headers that LAMMPS bundles, and the system
+//    libfmt-dev (9.x) no longer has fmt::make_args_checked, which the templates in utils.h
+//    and error.h name. This header is force-included before any LAMMPS header and declares a
+//    replacement, so the headers parse. Our code calls only the std::string overloads of
+//    error->all/one/warning and utils::logmesg and formats its messages itself.
+// 2. Communication: LAMMPS 2022 and later renamed comm->forward_comm_fix(this) to
+//    comm->forward_comm(this). Our code calls the fibre_forward_comm/fibre_reverse_comm
+//    wrappers below, so only this file changes for a newer LAMMPS.
+#pragma once
+
+#ifdef __cplusplus
+#include <fmt/format.h>
+
+namespace fmt {
+template <typename... Args, typename S>
+inline auto make_args_checked(const S &, const Args &...args)
+{
+  return fmt::make_format_args(args...);
+}
+}  // namespace fmt
+
+#define FIBRE_LAMMPS_COMM_FIX_API 1  // 2021 API: forward_comm_fix / reverse_comm_fix
+#define fibre_forward_comm(comm, fix, n) (comm)->forward_comm_fix((fix), (n))
+#define fibre_reverse_comm(comm, fix, n) (comm)->reverse_comm_fix((fix), (n))
+#endif

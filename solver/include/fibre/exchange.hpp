@@ -1,0 +1,47 @@
+// The communicator interface of the solver library (design.md section 6).
+//
+// The library never calls MPI itself for halo data: the front end (the LAMMPS fix) implements
+// forward/reverse exchange of per-body vectors, and global sums. Serial runs and unit tests
+// use SerialExchange.
+#pragma once
+
+#include "fibre/system.hpp"
+
+namespace fibre {
+
+class Exchange {
+ public:
+  virtual ~Exchange() = default;
+  // Per-body vector (6 per body, owned then ghosts): copy every owner's value to its ghosts.
+  virtual void forward(Vector &body_vec) const = 0;
+  // Add every ghost's value into its owner, then zero the ghosts.
+  virtual void reverse_sum(Vector &body_vec) const = 0;
+  // Global sum over all processes, in place.
+  virtual void sum(double *values, int n) const = 0;
+  // Global maximum over all processes, in place.
+  virtual void max(double *values, int n) const = 0;
+
+  double sum(double x) const
+  {
+    sum(&x, 1);
+    return x;
+  }
+  double max(double x) const
+  {
+    max(&x, 1);
+    return x;
+  }
+};
+
+// One process, no ghosts.
+class SerialExchange final : public Exchange {
+ public:
+  void forward(Vector &) const override {}
+  void reverse_sum(Vector &) const override {}
+  void sum(double *, int) const override {}
+  void max(double *, int) const override {}
+};
+
+const Exchange &serial_exchange();
+
+}  // namespace fibre

@@ -1,0 +1,46 @@
+// Matrix-free kernels on a ContactSystem (thesis 2.5.2): G is never formed.
+//
+// Contact-space vectors have rows() entries per contact; body-space vectors have 6 entries
+// per body (owned bodies first, then ghosts). Local kernels touch only this process's data;
+// the operators in operators.hpp add the halo exchange.
+#pragma once
+
+#include "fibre/exchange.hpp"
+#include "fibre/system.hpp"
+
+namespace fibre {
+
+// out = G w (local: w must be complete on ghosts).
+void g_apply(const ContactSystem &sys, const Vector &w, Vector &out);
+// out = G^T lambda, accumulated per body (local: ghosts hold partial sums).
+void gt_apply(const ContactSystem &sys, const Vector &lambda, Vector &out);
+
+// y = (G M^-1 G^T + Sigma) x. `work` is a body-space scratch vector.
+void schur_apply(const ContactSystem &sys, const Exchange &ex, const Vector &x, Vector &y,
+                 Vector &work);
+// y = (M + G^T Sigma^-1 G) x for a body-space x; ghost entries of y are zero.
+void body_apply(const ContactSystem &sys, const Exchange &ex, const Vector &x, Vector &y,
+                Vector &work);
+
+// The Jacobian block of contact c for its body a (side 0) or b (side 1): rows() x 6, padded
+// with zero rows to 6x6. Masked rows are zero.
+Mat6 jacobian_block(const ContactSystem &sys, int c, int side);
+
+// Diagonal 6x6 block of A for contact c: sum over its bodies of G_cj M_j^-1 G_cj^T + Sigma_c.
+// Rows/columns beyond rows() are identity.
+Mat6 diagonal_block(const ContactSystem &sys, int c);
+// Coupling block A_cd = sum over bodies j shared by c and d of G_cj M_j^-1 G_dj^T
+// (rows() x rows() in the top-left corner, zero elsewhere). Zero if they share no body.
+Mat6 coupling_block(const ContactSystem &sys, int c, int d);
+
+// Body-space blocks of K = M + G^T Sigma^-1 G.
+// Diagonal block of body i: M_i + sum over contacts c at i of G_ci^T Sigma_c^-1 G_ci.
+// Contacts on ghost bodies contribute only locally.
+std::vector<Mat6> body_diagonal_blocks(const ContactSystem &sys);
+// Off-diagonal block K_ab = G_ca^T Sigma_c^-1 G_cb of a body-body contact c.
+Mat6 body_coupling_block(const ContactSystem &sys, int c);
+
+// Dense M (6 per body) as a vector: the diagonal of M.
+Vector mass_diagonal(const ContactSystem &sys);
+
+}  // namespace fibre

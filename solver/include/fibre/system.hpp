@@ -1,0 +1,142 @@
+// Bodies, contacts and the SPOOK contact system (design.md section 2, thesis 2.1-2.2).
+//
+// Plain data: a ContactSystem owns its bodies and contacts and the derived per-contact
+// kinematics, Sigma and right-hand side. Nothing here knows about MPI or LAMMPS; bodies
+// [0, num_owned) are owned by this process, the rest are halo copies (ghosts).
+#pragma once
+
+#include <Eigen/Dense>
+#include <array>
+#include <vector>
+
+namespace fibre {
+
+using Vec3 = Eigen::Vector3d;
+using Vec6 = Eigen::Matrix<double, 6, 1>;
+using Mat3 = Eigen::Matrix3d;
+using Mat6 = Eigen::Matrix<double, 6, 6>;
+using Vector = Eigen::VectorXd;
+
+inline constexpr int kBodyDofs = 6;  // (velocity, angular velocity)
+inline constexpr int kMaxRows = 6;   // rows per contact: n, t1, t2, twist, roll1, roll2
+
+// A rigid sphere. Inertia is (2/5) m r^2 (solid sphere).
+struct Body {
+  double mass = 1.0;
+  double radius = 1.0;
+  Vec3 x = Vec3::Zero();
+  Vec3 v = Vec3::Zero();
+  Vec3 omega = Vec3::Zero();
+  Vec3 force = Vec3::Zero();   // external force (gravity, other fixes), held over the step
+  Vec3 torque = Vec3::Zero();  // external torque
+};
+
+// One contact: body a against body b, or body a against a wall (b == -1).
+struct Contact {
+  int a = -1;
+  int b = -1;                   // -1: wall
+  Vec3 normal = Vec3::UnitZ();  // unit, pointing from b (or the wall) to a
+  Vec3 t1 = Vec3::UnitX();      // tangent frame, orthonormal with normal
+  Vec3 t2 = Vec3::UnitY();
+  Vec3 point = Vec3::Zero();    // contact point
+  double gap = 0.0;             // signed distance, negative = overlap
+  std::array<double, kMaxRows> compliance{};  // per-row eps (1/stiffness)
+  bool is_wall() const { return b < 0; }
+};
+
+// A deterministic orthonormal completion (t1, t2) of the unit vector n.
+void tangent_frame(const Vec3 &n, Vec3 &t1, Vec3 &t2);
+
+// Contact between two spheres (a, b); point halfway through the overlap.
+Contact sphere_sphere_contact(const std::vector<Body> &bodies, int a, int b);
+// Contact between sphere a and a wall: `normal` points from the wall into the sphere and
+// `distance` is the centre's distance from the wall surface along it.
+Contact sphere_wall_contact(const std::vector<Body> &bodies, int a, const Vec3 &normal,
+                            double distance);
+
+// Per-contact kinematics: G_a w_a = [D (v_a + omega_a x ra) ; D omega_a] with D the frame
+// (rows n, t1, t2); G_b the same with minus sign and rb. This is thesis eq. 2.1.1 written
+// with 15 numbers instead of two 6x6 blocks.
+struct ContactKinematics {
+  Mat3 frame;  // rows: n, t1, t2
+  Vec3 ra;     // p - x_a
+  Vec3 rb;     // p - x_b (unused for walls)
+};
+
+// SPOOK parameters (design.md section 2).
+struct SpookParams {
+  double h = 1e-3;       // time step
+  double damping = 2.0;  // d = tau / h, in steps (thesis uses tau = 2h)
+  double upsilon() const { return 1.0 / (1.0 + 4.0 * damping); }
+  // Sigma entry for compliance eps: 4 eps / (h^2 (1 + 4 d)).
+  double sigma(double eps) const { return 4.0 * eps / (h * h * (1.0 + 4.0 * damping)); }
+};
+
+class ContactSystem {
+ public:
+  ContactSystem() = default;
+  // rows: 3 (translational only) or 6. num_owned: bodies [0, num_owned) are owned;
+  // -1 means all. Computes kinematics, inverse masses and Sigma; the rhs is zero until
+  // spook_rhs() or set_rhs() is called.
+  ContactSystem(std::vector<Body> bodies, std::vector<Contact> contacts, int rows,
+                const SpookParams &params, int num_owned = -1);
+
+  int rows() const { return rows_; }
+  int num_bodies() const { return static_cast<int>(bodies_.size()); }
+  int num_owned_bodies() const { return num_owned_; }
+  int num_contacts() const { return static_cast<int>(contacts_.size()); }
+  Eigen::Index contact_dofs() const { return Eigen::Index(rows_) * num_contacts(); }
+  Eigen::Index body_dofs() const { return Eigen::Index(kBodyDofs) * num_bodies(); }
+  const SpookParams &params() const { return params_; }
+
+  const std::vector<Body> &bodies() const { return bodies_; }
+  const std::vector<Contact> &contacts() const { return contacts_; }
+  const ContactKinematics &kinematics(int c) const { return kin_[c]; }
+  const Vector &inv_mass() const { return inv_mass_; }  // diagonal of M^-1, 6 per body
+  const Vector &sigma() const { return sigma_; }        // diagonal of Sigma, rows per contact
+  const Vector &rhs() const { return rhs_; }
+  void set_rhs(const Vector &b) { rhs_ = b; }
+
+  // Active-set support: a masked row has a zero Jacobian row, Sigma 1 and rhs 0, so it is
+  // decoupled (its lambda solves to 0) while every block structure stays intact.
+  const std::vector<unsigned char> &row_mask() const { return mask_; }
+  void set_row_mask(const std::vector<unsigned char> &active);  // 1 = active row
+  bool row_active(Eigen::Index row) const { return mask_.empty() || mask_[row] != 0; }
+
+  // Renumber bodies and contacts (used by the fibre relabelling). new_body[i] is the new
+  // index of body i, new_contact[c] the new index of contact c. Owned bodies must stay in
+  // [0, num_owned). Everything derived is permuted along.
+  void permute(const std::vector<int> &new_body, const std::vector<int> &new_contact);
+
+ private:
+  void compute_derived();
+
+  int rows_ = 6;
+  int num_owned_ = 0;
+  SpookParams params_;
+  std::vector<Body> bodies_;
+  std::vector<Contact> contacts_;
+  std::vector<ContactKinematics> kin_;
+  std::vector<unsigned char> mask_;  // empty = all rows active
+  Vector inv_mass_;
+  Vector sigma_;
+  Vector rhs_;
+};
+
+// ---- SPOOK step (design.md section 2) ----
+
+// Per-body velocity vector (v, omega) stacked, 6 per body.
+Vector body_velocities(const ContactSystem &sys);
+// h M^-1 f_ext per body (the free-flight velocity change).
+Vector external_velocity_change(const ContactSystem &sys);
+
+// b = -(4/h) Upsilon g - (1 - Upsilon) G v - G (h M^-1 f_ext + extra_dv).
+// extra_dv (optional, 6 per body) is a velocity change from impulses held fixed outside the
+// solve (capped friction rows); it must be complete on ghosts as well.
+Vector spook_rhs(const ContactSystem &sys, const Vector *extra_dv = nullptr);
+
+// Sum of the contact impulses on every body, dv = M^-1 G^T lambda (local part: the caller
+// reverse-sums ghosts for MPI).
+Vector impulse_velocity_change(const ContactSystem &sys, const Vector &lambda);
+
+}  // namespace fibre

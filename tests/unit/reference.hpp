@@ -1,0 +1,87 @@
+// Independent dense references for the unit tests: G, M^-1 and A assembled entry by entry
+// from the thesis's block formula (eq. 2.1.1), without the library's kernels.
+#pragma once
+
+#include <Eigen/Dense>
+
+#include "fibre/system.hpp"
+
+namespace fibre::test {
+
+using Dense = Eigen::MatrixXd;
+
+// Dense G: rows() per contact, 6 per body (masked rows zero).
+inline Dense dense_G(const ContactSystem &sys)
+{
+  const int rows = sys.rows();
+  Dense G = Dense::Zero(sys.contact_dofs(), sys.body_dofs());
+  for (int c = 0; c < sys.num_contacts(); ++c) {
+    const Contact &k = sys.contacts()[c];
+    const Vec3 dirs[3] = {k.normal, k.t1, k.t2};
+    for (int r = 0; r < rows; ++r) {
+      const Eigen::Index row = Eigen::Index(rows) * c + r;
+      if (!sys.row_active(row)) continue;
+      const Vec3 &d = dirs[r % 3];
+      if (r < 3) {
+        G.block<1, 3>(row, 6 * k.a) = d.transpose();
+        G.block<1, 3>(row, 6 * k.a + 3) = (k.point - sys.bodies()[k.a].x).cross(d).transpose();
+        if (!k.is_wall()) {
+          G.block<1, 3>(row, 6 * k.b) = -d.transpose();
+          G.block<1, 3>(row, 6 * k.b + 3) =
+              -(k.point - sys.bodies()[k.b].x).cross(d).transpose();
+        }
+      } else {
+        G.block<1, 3>(row, 6 * k.a + 3) = d.transpose();
+        if (!k.is_wall()) G.block<1, 3>(row, 6 * k.b + 3) = -d.transpose();
+      }
+    }
+  }
+  return G;
+}
+
+inline Dense dense_Minv(const ContactSystem &sys)
+{
+  Dense Minv = Dense::Zero(sys.body_dofs(), sys.body_dofs());
+  for (int i = 0; i < sys.num_bodies(); ++i) {
+    const Body &b = sys.bodies()[i];
+    for (int k = 0; k < 3; ++k) {
+      Minv(6 * i + k, 6 * i + k) = 1.0 / b.mass;
+      Minv(6 * i + 3 + k, 6 * i + 3 + k) = 1.0 / (0.4 * b.mass * b.radius * b.radius);
+    }
+  }
+  return Minv;
+}
+
+inline Eigen::VectorXd dense_sigma(const ContactSystem &sys)
+{
+  Eigen::VectorXd s(sys.contact_dofs());
+  const SpookParams &p = sys.params();
+  for (int c = 0; c < sys.num_contacts(); ++c)
+    for (int r = 0; r < sys.rows(); ++r) {
+      const Eigen::Index row = Eigen::Index(sys.rows()) * c + r;
+      s[row] = sys.row_active(row)
+          ? 4.0 * sys.contacts()[c].compliance[r] / (p.h * p.h * (1.0 + 4.0 * p.damping))
+          : 1.0;
+    }
+  return s;
+}
+
+// A = G M^-1 G^T + Sigma.
+inline Dense dense_A(const ContactSystem &sys)
+{
+  const Dense G = dense_G(sys);
+  Dense A = G * dense_Minv(sys) * G.transpose();
+  A.diagonal() += dense_sigma(sys);
+  return A;
+}
+
+// K = M + G^T Sigma^-1 G.
+inline Dense dense_K(const ContactSystem &sys)
+{
+  const Dense G = dense_G(sys);
+  Dense K = G.transpose() * dense_sigma(sys).cwiseInverse().asDiagonal() * G;
+  K.diagonal() += dense_Minv(sys).diagonal().cwiseInverse();
+  return K;
+}
+
+}  // namespace fibre::test
