@@ -21,6 +21,9 @@ class Exchange {
   // Global maximum over all processes, in place.
   virtual void max(double *values, int n) const = 0;
 
+  // Exclusive prefix sum over processes in rank order (0 on the first).
+  virtual long exclusive_prefix_sum(long local) const = 0;
+
   double sum(double x) const
   {
     sum(&x, 1);
@@ -40,7 +43,13 @@ class SerialExchange final : public Exchange {
   void reverse_sum(Vector &) const override {}
   void sum(double *, int) const override {}
   void max(double *, int) const override {}
+  long exclusive_prefix_sum(long) const override { return 0; }
 };
+
+// Index of every local body (owned, then ghosts) in one global numbering of all owned bodies
+// of all processes; `total` receives their count. Uses exclusive_prefix_sum and forward.
+std::vector<long> global_body_index(const Exchange &ex, int num_owned, int num_bodies,
+                                    long &total);
 
 const Exchange &serial_exchange();
 
