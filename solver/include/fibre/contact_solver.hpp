@@ -16,6 +16,8 @@ enum class SolverKind { uzawa, cr, minres, direct };
 const char *to_string(SolverKind s);
 bool parse_solver(const std::string &s, SolverKind &k);
 
+// r_eff = ra rb / (ra + rb) for a pair, ra against a wall. A zero coefficient means no
+// resistance: those rows never enter the solve and carry no impulse.
 struct FrictionParams {
   double mu = 0.5;        // Coulomb: |lambda_t| <= mu lambda_n
   double mu_roll = 0.0;   // rolling: |lambda_roll| <= mu_roll r_eff lambda_n
@@ -29,29 +31,47 @@ struct StepOptions {
   StopControl stop{};
   FrictionParams friction{};
   int active_set_max = 5;  // K: passes of the active-set loop
+  // The loop has settled when the set stops changing and the capped impulses (mu l_n along
+  // the slip direction, from the newest l_n) move by at most cap_tol * max |lambda|.
+  double cap_tol = 1e-6;
 };
 
+// Counts (released, capped) are global over all processes; so are the Krylov figures.
 struct StepResult {
   Vector lambda;          // final, feasible impulses (rows per contact)
   Vector dv;              // velocity change from the contacts, M^-1 G^T lambda (owned bodies)
-  int iterations = 0;     // Krylov iterations of the last linear solve
+  int iterations = 0;     // Krylov iterations of the last linear solve (0 for direct)
   int total_iterations = 0;
-  double rel_residual = 0;  // of the last linear solve
-  StopReason reason = StopReason::converged;
+  double rel_residual = 0;  // of the last linear solve: true ||b - A x|| / ||b|| in its form
+  StopReason reason = StopReason::converged;  // first failed solve's reason, else converged
   bool converged = true;    // every linear solve converged
-  int active_set_passes = 0;
-  int released = 0;         // contacts released (lambda_n < 0)
-  int capped = 0;           // friction rows capped on their cone
-  FibreStats fibres;
-  double setup_seconds = 0;
-  double solve_seconds = 0;
+  int active_set_passes = 0;  // linear solves done (1 .. active_set_max)
+  bool set_settled = false;   // the active set and its caps settled (see cap_tol)
+  int released = 0;         // contacts with zero impulse at the end (lambda_n < 0)
+  int capped = 0;           // friction/rolling/twisting rows on their cone boundary
+  FibreStats fibres;        // of the last pass's preconditioner
+  double setup_seconds = 0;  // preconditioner builds
+  double solve_seconds = 0;  // linear solves (direct: analysis, factorization and solve)
+  double total_seconds = 0;  // the whole call
 };
 
 // Solves the contact problem of `sys`. Its bodies must hold the step's velocities and
-// external forces, complete on ghosts; the rhs (spook_rhs) and the row mask are set here.
-// `warm` (optional, rows per contact) is the warm start. `comm` is the communicator the
-// direct solver (MUMPS) runs on; the body numbering across processes comes from
-// global_body_index().
+// external forces, complete on ghosts; the rhs (spook_rhs) and the row mask are set here,
+// and on return every row is active again and the rhs is the full spook_rhs(sys).
+// Collective: every process calls it once per step (it may hold no contacts).
+// `warm` (optional, rows per contact) is the warm start; cones on which it lies start capped.
+// `comm` is the communicator the direct solver (MUMPS) runs on; the body numbering across
+// processes comes from global_body_index(). MUMPS failures propagate as DirectSolverError.
+// A solve that does not converge, or non-finite data, still gives finite lambda and dv
+// (converged = false).
+//
+// The active-set loop (design.md section 2): each pass solves the rows of the current set
+// with the capped cones' impulses in the rhs; contacts with lambda_n < 0 are released, cones
+// that leave their radius are capped along the solved direction. Rows outside the solve are
+// judged by their trial impulse (lambda + rho / sigma with rho the row's residual): released
+// contacts that would press again come back, capped cones that would stick are freed, at
+// most 3 times per contact and cone in a step (anti-cycling). A final projection then makes
+// lambda feasible (lambda_n >= 0, every cone).
 StepResult solve_step(ContactSystem &sys, const Exchange &ex, const StepOptions &opt,
                       const Vector *warm, MPI_Comm comm);
 

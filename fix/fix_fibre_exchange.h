@@ -1,0 +1,59 @@
+// The solver library's communicator interface (fibre::Exchange) implemented with LAMMPS's
+// halo communication, for fix fibre_contact.
+//
+// Bodies are atoms: body k of the contact system is local atom body_atom[k], owned bodies
+// first, then ghosts. forward() and reverse_sum() move 6 doubles per atom through the fix's
+// pack/unpack_forward_comm and pack/unpack_reverse_comm (comm_forward = comm_reverse = 6);
+// the global reductions use MPI on the fix's world communicator.
+#pragma once
+
+#include <mpi.h>
+
+#include <vector>
+
+#include "fibre/exchange.hpp"
+
+namespace LAMMPS_NS {
+class LAMMPS;
+class Fix;
+}  // namespace LAMMPS_NS
+
+namespace fibre_lmp {
+
+class LammpsExchange final : public fibre::Exchange {
+ public:
+  static constexpr int kValuesPerAtom = 6;
+
+  LammpsExchange(LAMMPS_NS::LAMMPS *lmp, LAMMPS_NS::Fix *fix, MPI_Comm world);
+
+  // Body k <-> local atom body_atom[k]; bodies [0, num_owned) are owned atoms (< nlocal).
+  void set_bodies(const std::vector<int> &body_atom, int num_owned);
+  int num_owned() const { return num_owned_; }
+  const std::vector<int> &body_atom() const { return body_atom_; }
+
+  void forward(fibre::Vector &body_vec) const override;
+  void reverse_sum(fibre::Vector &body_vec) const override;
+  void sum(double *values, int n) const override;
+  void max(double *values, int n) const override;
+  long exclusive_prefix_sum(long local) const override;
+  using fibre::Exchange::max;
+  using fibre::Exchange::sum;
+
+  // Called from the fix's pack/unpack methods: 6 values per atom from/to the halo buffer.
+  int pack_forward(int n, const int *list, double *buf) const;
+  void unpack_forward(int first, int n, const double *buf) const;
+  int pack_reverse(int first, int n, double *buf) const;
+  void unpack_reverse(int n, const int *list, const double *buf) const;
+
+ private:
+  void resize_halo() const;
+
+  LAMMPS_NS::LAMMPS *lmp_;
+  LAMMPS_NS::Fix *fix_;
+  MPI_Comm world_;
+  std::vector<int> body_atom_;
+  int num_owned_ = 0;
+  mutable std::vector<double> halo_;  // 6 per local atom (owned + ghost)
+};
+
+}  // namespace fibre_lmp

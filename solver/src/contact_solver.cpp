@@ -1,0 +1,405 @@
+#include "fibre/contact_solver.hpp"
+
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+
+#include "fibre/direct.hpp"
+#include "fibre/kernels.hpp"
+
+namespace fibre {
+
+const char *to_string(SolverKind s)
+{
+  switch (s) {
+    case SolverKind::uzawa: return "uzawa";
+    case SolverKind::cr: return "cr";
+    case SolverKind::minres: return "minres";
+    case SolverKind::direct: return "direct";
+  }
+  return "unknown";
+}
+
+bool parse_solver(const std::string &s, SolverKind &k)
+{
+  if (s == "direct" || s == "mumps") {
+    k = SolverKind::direct;
+    return true;
+  }
+  Method m;
+  if (!parse_method(s, m)) return false;
+  k = m == Method::uzawa ? SolverKind::uzawa : m == Method::cr ? SolverKind::cr
+                                                                 : SolverKind::minres;
+  return true;
+}
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double seconds_since(Clock::time_point t0)
+{
+  return std::chrono::duration<double>(Clock::now() - t0).count();
+}
+
+Method krylov_method(SolverKind s)
+{
+  if (s == SolverKind::uzawa) return Method::uzawa;
+  return s == SolverKind::cr ? Method::cr : Method::minres;
+}
+
+// The cones of one contact: Coulomb (rows 1, 2), twisting (row 3), rolling (rows 4, 5).
+struct Cone {
+  int first, size;
+};
+constexpr Cone kCones[3] = {{1, 2}, {3, 1}, {4, 2}};
+
+int num_cones(int rows) { return rows == 6 ? 3 : 1; }
+
+double effective_radius(const ContactSystem &sys, int c)
+{
+  const Contact &k = sys.contacts()[c];
+  const double ra = sys.bodies()[k.a].radius;
+  if (k.is_wall()) return ra;
+  const double rb = sys.bodies()[k.b].radius;
+  return ra * rb / (ra + rb);
+}
+
+// Cone radius per unit normal impulse.
+double cone_coefficient(const ContactSystem &sys, const FrictionParams &f, int c, int cone)
+{
+  if (cone == 0) return f.mu;
+  return (cone == 1 ? f.mu_twist : f.mu_roll) * effective_radius(sys, c);
+}
+
+// One contact's place in the active set. A capped cone holds its impulse on the boundary,
+// radius * dir, outside the solve. Releasing and capping may be undone kMaxReversals times per
+// step and contact: redundant networks can otherwise make the loop cycle between two sets.
+constexpr int kMaxReversals = 3;
+struct ContactState {
+  bool released = false;
+  int reactivations = 0;
+  bool capped[3] = {false, false, false};
+  int uncaps[3] = {0, 0, 0};
+  Eigen::Vector2d dir[3] = {Eigen::Vector2d::Zero(), Eigen::Vector2d::Zero(),
+                           Eigen::Vector2d::Zero()};
+};
+
+Eigen::Vector2d cone_values(const Vector &v, Eigen::Index base, const Cone &cone)
+{
+  Eigen::Vector2d t(v[base + cone.first], 0.0);
+  if (cone.size == 2) t[1] = v[base + cone.first + 1];
+  return t;
+}
+
+void set_cone(Vector &v, Eigen::Index base, const Cone &cone, const Eigen::Vector2d &t)
+{
+  v[base + cone.first] = t[0];
+  if (cone.size == 2) v[base + cone.first + 1] = t[1];
+}
+
+// The active-set loop of design.md section 2 around one linear solver.
+class StepSolver {
+ public:
+  StepSolver(ContactSystem &sys, const Exchange &ex, const StepOptions &opt, MPI_Comm comm)
+      : sys_(sys), ex_(ex), opt_(opt), comm_(comm), rows_(sys.rows()),
+        nc_(sys.num_contacts()), coeff_(std::size_t(nc_) * 3, 0.0), state_(nc_),
+        all_rows_(sys.contact_dofs(), 1)
+  {
+    for (int c = 0; c < nc_; ++c)
+      for (int k = 0; k < num_cones(rows_); ++k)
+        coeff_[3 * std::size_t(c) + k] = cone_coefficient(sys, opt.friction, c, k);
+  }
+
+  StepResult run(const Vector *warm);
+
+ private:
+  double coeff(int c, int k) const { return coeff_[3 * std::size_t(c) + k]; }
+  Eigen::Index base(int c) const { return Eigen::Index(rows_) * c; }
+  void precap_from_warm(const Vector &lambda);
+  std::vector<unsigned char> active_mask() const;
+  Vector fixed_impulses(const Vector &lambda) const;
+  Vector velocity_change(const Vector &lambda) const;
+  Vector linear_solve(const Vector &b, const Vector &warm, StepResult &res);
+  int update_set(const Vector &lambda, const std::vector<unsigned char> &mask);
+  void project(Vector &lambda, StepResult &res) const;
+
+  ContactSystem &sys_;
+  const Exchange &ex_;
+  const StepOptions &opt_;
+  MPI_Comm comm_;
+  const int rows_, nc_;
+  std::vector<double> coeff_;  // cone coefficient per contact and cone
+  std::vector<ContactState> state_;
+  const std::vector<unsigned char> all_rows_;
+  Vector b_full_;  // the rhs with every row active and no fixed impulses
+  StopReason last_reason_ = StopReason::converged;
+};
+
+// Cones whose warm impulse lies on or outside the boundary start capped (a sliding contact
+// stays sliding from step to step); the trial test of update_set() undoes a wrong guess.
+void StepSolver::precap_from_warm(const Vector &lambda)
+{
+  for (int c = 0; c < nc_; ++c) {
+    const double ln = lambda[base(c)];
+    if (!(ln > 0)) continue;
+    for (int k = 0; k < num_cones(rows_); ++k) {
+      const double radius = coeff(c, k) * ln;
+      const Eigen::Vector2d t = cone_values(lambda, base(c), kCones[k]);
+      if (radius > 0 && t.norm() >= radius * (1 - 1e-9)) {
+        state_[c].capped[k] = true;
+        state_[c].dir[k] = t / t.norm();
+      }
+    }
+  }
+}
+
+std::vector<unsigned char> StepSolver::active_mask() const
+{
+  std::vector<unsigned char> mask(all_rows_.size(), 0);
+  for (int c = 0; c < nc_; ++c) {
+    if (state_[c].released) continue;
+    mask[base(c)] = 1;
+    for (int k = 0; k < num_cones(rows_); ++k) {
+      if (coeff(c, k) <= 0 || state_[c].capped[k]) continue;
+      for (int i = 0; i < kCones[k].size; ++i) mask[base(c) + kCones[k].first + i] = 1;
+    }
+  }
+  return mask;
+}
+
+// Impulses of the capped cones, from the newest normal impulse.
+Vector StepSolver::fixed_impulses(const Vector &lambda) const
+{
+  Vector fixed = Vector::Zero(sys_.contact_dofs());
+  for (int c = 0; c < nc_; ++c) {
+    if (state_[c].released) continue;
+    const double ln = std::max(lambda[base(c)], 0.0);
+    for (int k = 0; k < num_cones(rows_); ++k)
+      if (state_[c].capped[k])
+        set_cone(fixed, base(c), kCones[k], coeff(c, k) * ln * state_[c].dir[k]);
+  }
+  return fixed;
+}
+
+// M^-1 G^T lambda, complete on owned bodies and ghosts (the rows of the current mask).
+Vector StepSolver::velocity_change(const Vector &lambda) const
+{
+  Vector dv;
+  gt_apply(sys_, lambda, dv);
+  ex_.reverse_sum(dv);
+  dv.array() *= sys_.inv_mass().array();
+  ex_.forward(dv);
+  return dv;
+}
+
+// Solves the masked system A lambda = b in the chosen form and returns lambda.
+Vector StepSolver::linear_solve(const Vector &b, const Vector &warm, StepResult &res)
+{
+  SolveResult sr;
+  Vector lambda;
+  // Non-finite data (a body with NaN velocity) reach no solver: the warm start stands.
+  if (ex_.max(b.allFinite() ? 0.0 : 1.0) > 0) {
+    sr.reason = StopReason::non_finite;
+    sr.rel_residual = std::numeric_limits<double>::infinity();
+    lambda = warm;
+  } else if (opt_.solver == SolverKind::direct) {
+    const auto t0 = Clock::now();
+    lambda = direct_solve(opt_.form, sys_, ex_, b, comm_);
+    res.solve_seconds += seconds_since(t0);
+    ContactSpaceOperator A(sys_, ex_);
+    Vector Alambda;
+    A.apply(lambda, Alambda);
+    const double b_norm = A.norm(b);
+    sr.reason = lambda.allFinite() ? StopReason::converged : StopReason::non_finite;
+    if (ex_.max(sr.reason == StopReason::non_finite ? 1.0 : 0.0) > 0) {
+      sr.reason = StopReason::non_finite;
+      lambda = warm;
+    }
+    sr.iterations = 0;
+    sr.rel_residual = b_norm > 0 ? A.norm(b - Alambda) / b_norm : 0.0;
+  } else {
+    const auto t0 = Clock::now();
+    PrecondOptions popt = opt_.precond;
+    Vector last_normal;
+    if (popt.kind != PrecondKind::none && popt.weight == EdgeWeight::impulse && !popt.impulses) {
+      // The warm start's normal impulses stand in for the last step's.
+      last_normal = Vector::Zero(nc_);
+      for (int c = 0; c < nc_; ++c) last_normal[c] = warm[base(c)];
+      popt.impulses = &last_normal;
+    }
+    const auto P = make_preconditioner(opt_.form, sys_, ex_, popt, &res.fibres);
+    res.setup_seconds += seconds_since(t0);
+    const auto t1 = Clock::now();
+    const auto A = make_operator(opt_.form, sys_, ex_);
+    const Method m = krylov_method(opt_.solver);
+    if (opt_.form == Form::contact) {
+      lambda = warm;
+      sr = krylov_solve(m, *A, *P, b, lambda, opt_.stop);
+    } else {
+      Vector dv = body_from_lambda(sys_, ex_, warm);
+      sr = krylov_solve(m, *A, *P, body_rhs(sys_, ex_, b), dv, opt_.stop);
+      lambda = lambda_from_body(sys_, ex_, b, dv);
+    }
+    res.solve_seconds += seconds_since(t1);
+  }
+  last_reason_ = sr.reason;
+  res.iterations = sr.iterations;
+  res.total_iterations += sr.iterations;
+  res.rel_residual = sr.rel_residual;
+  if (!sr.converged() && res.converged) {
+    res.converged = false;
+    res.reason = sr.reason;
+  }
+  return lambda;
+}
+
+// Decides the next active set from the pass's lambda (active rows solved, capped rows fixed).
+// Rows outside the solve are judged by their trial impulse lambda + rho / sigma, rho the row's
+// residual of the full system (the regularized row equation solved for that row alone): it
+// re-activates released contacts that would press again and un-caps cones that would stick.
+// A capped cone keeps the slip direction it was capped with: following the newest direction
+// makes the caps oscillate (measured on random-velocity piles), the magnitude follows l_n.
+// Returns the number of local changes wanted (a reversal over budget counts but is not done).
+int StepSolver::update_set(const Vector &lambda, const std::vector<unsigned char> &mask)
+{
+  Vector G_dv;
+  g_apply(sys_, velocity_change(lambda), G_dv);
+  const Vector rho = b_full_ - G_dv - sys_.sigma().cwiseProduct(lambda);
+  Vector value = lambda;
+  for (Eigen::Index row = 0; row < value.size(); ++row)
+    if (!mask[row]) value[row] += rho[row] / sys_.sigma()[row];
+
+  int changes = 0;
+  for (int c = 0; c < nc_; ++c) {
+    ContactState &st = state_[c];
+    const double ln = value[base(c)];
+    if (st.released && ln > 0) {
+      ++changes;  // also when blocked: the set is then not settled, only frozen
+      if (st.reactivations < kMaxReversals) {
+        ++st.reactivations;
+        st.released = false;
+      }
+    } else if (!st.released && !(ln > 0)) {
+      ++changes;
+      st.released = true;
+    }
+    if (st.released) {
+      for (bool &capped : st.capped) capped = false;
+      continue;
+    }
+    for (int k = 0; k < num_cones(rows_); ++k) {
+      const double radius = coeff(c, k) * ln;
+      if (!(radius > 0)) continue;
+      const Eigen::Vector2d t = cone_values(value, base(c), kCones[k]);
+      const double tn = t.norm();
+      if (tn > radius) {
+        if (!st.capped[k]) st.dir[k] = t / tn;  // the solved slip direction
+        changes += !st.capped[k];
+        st.capped[k] = true;
+      } else if (st.capped[k] && tn < radius * (1 - 1e-9)) {
+        // The hysteresis keeps round-off from flipping a cone that sits on its boundary.
+        ++changes;
+        if (st.uncaps[k] < kMaxReversals) {
+          ++st.uncaps[k];
+          st.capped[k] = false;
+        }
+      }
+    }
+  }
+  return changes;
+}
+
+// Final projection: lambda_n >= 0 and every cone, capped cones on their boundary along the
+// slip direction with the final normal impulse.
+void StepSolver::project(Vector &lambda, StepResult &res) const
+{
+  double counts[2] = {0, 0};  // released contacts, rows on a cone boundary
+  for (int c = 0; c < nc_; ++c) {
+    const double ln = lambda[base(c)];
+    if (state_[c].released || !(ln > 0)) {
+      lambda.segment(base(c), rows_).setZero();
+      counts[0] += 1;
+      continue;
+    }
+    for (int k = 0; k < num_cones(rows_); ++k) {
+      const Cone &cone = kCones[k];
+      const double radius = coeff(c, k) * ln;
+      Eigen::Vector2d t = cone_values(lambda, base(c), cone);
+      if (state_[c].capped[k]) {
+        t = radius * state_[c].dir[k];
+      } else if (!(t.norm() <= radius)) {
+        t = t.norm() > 0 && std::isfinite(t.norm()) ? Eigen::Vector2d(t * (radius / t.norm()))
+                                                    : Eigen::Vector2d::Zero();
+      } else {
+        continue;
+      }
+      if (radius > 0) counts[1] += cone.size;
+      set_cone(lambda, base(c), cone, t);
+    }
+  }
+  ex_.sum(counts, 2);
+  res.released = static_cast<int>(counts[0]);
+  res.capped = static_cast<int>(counts[1]);
+}
+
+StepResult StepSolver::run(const Vector *warm)
+{
+  const auto t_start = Clock::now();
+  StepResult res;
+  const Eigen::Index n = sys_.contact_dofs();
+  sys_.set_row_mask(all_rows_);
+  b_full_ = spook_rhs(sys_);
+  // An unusable warm start is replaced by zero; the decision is global (collective solves).
+  const bool warm_ok = warm && warm->size() == n && warm->allFinite();
+  const bool use_warm = ex_.max(warm_ok ? 0.0 : 1.0) == 0.0;
+  Vector lambda = use_warm ? *warm : Vector::Zero(n);
+  if (use_warm) precap_from_warm(lambda);
+
+  for (int pass = 0; pass < std::max(1, opt_.active_set_max); ++pass) {
+    // Capped cones enter the rhs as a fixed velocity change, computed with every row active.
+    const Vector fixed = fixed_impulses(lambda);
+    const Vector extra_dv = velocity_change(fixed);
+    const std::vector<unsigned char> mask = active_mask();
+    sys_.set_row_mask(mask);
+    const Vector b = spook_rhs(sys_, &extra_dv);
+    sys_.set_rhs(b);
+    Vector warm_active = lambda;
+    for (Eigen::Index row = 0; row < n; ++row)
+      if (!mask[row]) warm_active[row] = 0.0;
+    const Vector solved = linear_solve(b, warm_active, res);
+    ++res.active_set_passes;
+    lambda = solved + fixed;  // disjoint rows
+    sys_.set_row_mask(all_rows_);
+    if (last_reason_ == StopReason::non_finite) break;
+    const int changes = update_set(lambda, mask);
+    // Settled: the same set, and caps (newest l_n) that moved by no more than cap_tol relative
+    // to the largest impulse. The caps converge linearly (a fixed-point iteration on l_n).
+    double drift[2] = {(fixed_impulses(lambda) - fixed).lpNorm<Eigen::Infinity>(),
+                       lambda.lpNorm<Eigen::Infinity>()};
+    ex_.max(drift, 2);
+    const double global_changes = ex_.sum(static_cast<double>(changes));
+    if (global_changes == 0 && drift[0] <= opt_.cap_tol * drift[1]) {
+      res.set_settled = true;
+      break;
+    }
+  }
+  project(lambda, res);
+  sys_.set_rhs(b_full_);
+  res.dv = body_from_lambda(sys_, ex_, lambda);
+  res.lambda = std::move(lambda);
+  res.total_seconds = seconds_since(t_start);
+  return res;
+}
+
+}  // namespace
+
+StepResult solve_step(ContactSystem &sys, const Exchange &ex, const StepOptions &opt,
+                      const Vector *warm, MPI_Comm comm)
+{
+  StepSolver solver(sys, ex, opt, comm);
+  return solver.run(warm);
+}
+
+}  // namespace fibre

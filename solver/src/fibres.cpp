@@ -1,0 +1,296 @@
+#include "fibre/fibres.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <numeric>
+#include <stdexcept>
+
+namespace fibre {
+
+const char *to_string(EdgeWeight w)
+{
+  switch (w) {
+    case EdgeWeight::z: return "z";
+    case EdgeWeight::straight: return "straight";
+    case EdgeWeight::impulse: return "impulse";
+  }
+  return "?";
+}
+
+bool parse_weight(const std::string &s, EdgeWeight &w)
+{
+  for (EdgeWeight c : {EdgeWeight::z, EdgeWeight::straight, EdgeWeight::impulse})
+    if (s == to_string(c)) {
+      w = c;
+      return true;
+    }
+  return false;
+}
+
+ContactGraph contact_graph(const ContactSystem &sys, bool include_ghosts)
+{
+  const int nb = sys.num_bodies(), nc = sys.num_contacts();
+  const int limit = include_ghosts ? nb : sys.num_owned_bodies();
+  const std::vector<Contact> &contacts = sys.contacts();
+  auto is_edge = [&](const Contact &k) { return !k.is_wall() && k.a < limit && k.b < limit; };
+  ContactGraph g;
+  g.start.assign(std::size_t(nb) + 1, 0);
+  for (const Contact &k : contacts)
+    if (is_edge(k)) {
+      ++g.start[k.a + 1];
+      ++g.start[k.b + 1];
+      ++g.num_edges;
+    }
+  for (int i = 0; i < nb; ++i) g.start[i + 1] += g.start[i];
+  g.neighbour.resize(std::size_t(2) * g.num_edges);
+  g.contact.resize(std::size_t(2) * g.num_edges);
+  std::vector<int> fill(g.start.begin(), g.start.end() - 1);
+  for (int c = 0; c < nc; ++c) {
+    const Contact &k = contacts[c];
+    if (!is_edge(k)) continue;
+    g.neighbour[fill[k.a]] = k.b;
+    g.contact[fill[k.a]++] = c;
+    g.neighbour[fill[k.b]] = k.a;
+    g.contact[fill[k.b]++] = c;
+  }
+  return g;
+}
+
+namespace {
+
+void check_impulses(const ContactSystem &sys, EdgeWeight weight, const Vector *impulses)
+{
+  if (weight == EdgeWeight::impulse && impulses && impulses->size() != sys.num_contacts())
+    throw std::invalid_argument("impulse weight needs one normal impulse per contact");
+}
+
+// The per-edge weight without the walk's history (Kruskal completion of the forest).
+double static_weight(const ContactSystem &sys, EdgeWeight weight, const Vector *impulses, int c)
+{
+  if (weight == EdgeWeight::impulse && impulses) return -(*impulses)[c];
+  const Contact &k = sys.contacts()[c];
+  return std::abs(sys.bodies()[k.a].x.z() - sys.bodies()[k.b].x.z());
+}
+
+}  // namespace
+
+double edge_weight(const ContactSystem &sys, EdgeWeight weight, const Vector *impulses, int c,
+                   int from, const Vec3 &prev_dir)
+{
+  if (weight != EdgeWeight::straight) return static_weight(sys, weight, impulses, c);
+  if (prev_dir.isZero()) return 0.0;  // first edge of a fibre: no preference
+  const Contact &k = sys.contacts()[c];
+  const int to = k.a == from ? k.b : k.a;
+  const Vec3 e = sys.bodies()[to].x - sys.bodies()[from].x;
+  const double norms = e.norm() * prev_dir.norm();
+  return norms > 0 ? 1.0 - std::abs(e.dot(prev_dir)) / norms : 1.0;
+}
+
+Fibres build_fibres(const ContactSystem &sys, EdgeWeight weight, const Vector *impulses,
+                    bool include_ghosts)
+{
+  check_impulses(sys, weight, impulses);
+  const ContactGraph g = contact_graph(sys, include_ghosts);
+  const std::vector<Body> &bodies = sys.bodies();
+  const int nb = sys.num_bodies();
+  std::vector<char> taken(nb, 0);
+
+  // The smallest-weight contact from `cur` to an untaken body, ties to the smaller contact.
+  auto step = [&](int cur, const Vec3 &prev_dir, int &next, int &via) {
+    double best = 0;
+    via = -1;
+    for (int e = g.start[cur]; e < g.start[cur + 1]; ++e) {
+      const int other = g.neighbour[e], c = g.contact[e];
+      if (taken[other]) continue;
+      const double w = edge_weight(sys, weight, impulses, c, cur, prev_dir);
+      if (via < 0 || w < best || (w == best && c < via)) {
+        best = w;
+        via = c;
+        next = other;
+      }
+    }
+    return via >= 0;
+  };
+
+  Fibres f;
+  f.stats.num_contacts = g.num_edges;
+  std::vector<int> back_bodies, back_contacts;
+  for (int s = 0; s < nb; ++s) {
+    int next = -1, via = -1;
+    if (taken[s] || !step(s, Vec3::Zero(), next, via)) continue;
+    // Forward from s, appended in place; the backward part is prepended afterwards.
+    taken[s] = 1;
+    const std::size_t body_base = f.bodies.size(), contact_base = f.contacts.size();
+    f.bodies.push_back(s);
+    int cur = s;
+    Vec3 prev_dir = Vec3::Zero();
+    do {
+      taken[next] = 1;
+      f.bodies.push_back(next);
+      f.contacts.push_back(via);
+      prev_dir = bodies[next].x - bodies[cur].x;
+      cur = next;
+    } while (step(cur, prev_dir, next, via));
+    back_bodies.clear();
+    back_contacts.clear();
+    cur = s;
+    prev_dir = bodies[f.bodies[body_base + 1]].x - bodies[s].x;
+    while (step(cur, prev_dir, next, via)) {
+      taken[next] = 1;
+      back_bodies.push_back(next);
+      back_contacts.push_back(via);
+      prev_dir = bodies[next].x - bodies[cur].x;
+      cur = next;
+    }
+    f.bodies.insert(f.bodies.begin() + body_base, back_bodies.rbegin(), back_bodies.rend());
+    f.contacts.insert(f.contacts.begin() + contact_base, back_contacts.rbegin(),
+                      back_contacts.rend());
+    f.body_start.push_back(static_cast<int>(f.bodies.size()));
+    f.contact_start.push_back(static_cast<int>(f.contacts.size()));
+    const int len = static_cast<int>(f.contacts.size() - contact_base);
+    if (static_cast<int>(f.stats.length_histogram.size()) <= len)
+      f.stats.length_histogram.resize(len + 1, 0);
+    ++f.stats.length_histogram[len];
+  }
+  f.stats.num_fibres = f.num_fibres();
+  f.stats.contacts_in_fibres = static_cast<int>(f.contacts.size());
+  return f;
+}
+
+Relabelling relabel_for_fibres(const ContactSystem &sys, const Fibres &fibres)
+{
+  const int nb = sys.num_bodies(), nc = sys.num_contacts(), owned = sys.num_owned_bodies();
+  Relabelling r;
+  r.new_body.assign(nb, -1);
+  r.new_contact.assign(nc, -1);
+  int next_owned = 0, next_ghost = owned;
+  auto label_body = [&](int i) {
+    if (r.new_body[i] < 0) r.new_body[i] = i < owned ? next_owned++ : next_ghost++;
+  };
+  for (int i : fibres.bodies) label_body(i);
+  for (int i = 0; i < nb; ++i) label_body(i);
+  int next = 0;
+  for (int c : fibres.contacts) r.new_contact[c] = next++;
+  for (int c = 0; c < nc; ++c)
+    if (r.new_contact[c] < 0) r.new_contact[c] = next++;
+  return r;
+}
+
+Fibres relabelled(const Fibres &fibres, const Relabelling &r)
+{
+  Fibres out = fibres;
+  for (int &i : out.bodies) i = r.new_body[i];
+  for (int &c : out.contacts) c = r.new_contact[c];
+  return out;
+}
+
+Relabelling relabel_system(ContactSystem &sys, Fibres &fibres)
+{
+  Relabelling r = relabel_for_fibres(sys, fibres);
+  sys.permute(r.new_body, r.new_contact);
+  fibres = relabelled(fibres, r);
+  return r;
+}
+
+Vector relabel_contact_vector(const Relabelling &r, int rows, const Vector &x)
+{
+  Vector y(x.size());
+  for (std::size_t c = 0; c < r.new_contact.size(); ++c)
+    y.segment(Eigen::Index(rows) * r.new_contact[c], rows) =
+        x.segment(Eigen::Index(rows) * Eigen::Index(c), rows);
+  return y;
+}
+
+namespace {
+
+// Union-find with path halving.
+struct DisjointSets {
+  std::vector<int> up;
+  explicit DisjointSets(int n) : up(n) { std::iota(up.begin(), up.end(), 0); }
+  int find(int i)
+  {
+    while (up[i] != i) i = up[i] = up[up[i]];
+    return i;
+  }
+  bool join(int a, int b)
+  {
+    a = find(a);
+    b = find(b);
+    if (a == b) return false;
+    up[std::max(a, b)] = std::min(a, b);
+    return true;
+  }
+};
+
+}  // namespace
+
+Forest build_forest(const ContactSystem &sys, EdgeWeight weight, const Vector *impulses,
+                    bool include_ghosts)
+{
+  const Fibres fibres = build_fibres(sys, weight, impulses, include_ghosts);
+  const ContactGraph g = contact_graph(sys, include_ghosts);
+  const int nb = sys.num_bodies(), nc = sys.num_contacts();
+  const int limit = include_ghosts ? nb : sys.num_owned_bodies();
+
+  std::vector<char> in_tree(nc, 0);
+  DisjointSets sets(nb);
+  for (int c : fibres.contacts) {
+    in_tree[c] = 1;
+    sets.join(sys.contacts()[c].a, sys.contacts()[c].b);
+  }
+  std::vector<std::pair<double, int>> rest;
+  rest.reserve(std::size_t(g.num_edges) - fibres.contacts.size());
+  for (int i = 0; i < limit; ++i)
+    for (int e = g.start[i]; e < g.start[i + 1]; ++e)
+      if (g.neighbour[e] > i && !in_tree[g.contact[e]])
+        rest.emplace_back(static_weight(sys, weight, impulses, g.contact[e]), g.contact[e]);
+  std::sort(rest.begin(), rest.end());
+  Forest f;
+  f.num_edges = static_cast<int>(fibres.contacts.size());
+  for (const auto &[w, c] : rest) {
+    (void)w;
+    if (sets.join(sys.contacts()[c].a, sys.contacts()[c].b)) {
+      in_tree[c] = 1;
+      ++f.num_edges;
+    }
+  }
+
+  // Root every tree at its smallest body and list bodies in DFS post-order.
+  f.parent.assign(nb, -1);
+  f.parent_contact.assign(nb, -1);
+  f.order.reserve(limit);
+  f.stats.num_contacts = g.num_edges;
+  f.stats.contacts_in_fibres = f.num_edges;
+  std::vector<char> seen(nb, 0);
+  std::vector<std::pair<int, int>> stack;  // (body, next adjacency position)
+  for (int root = 0; root < limit; ++root) {
+    if (seen[root]) continue;
+    seen[root] = 1;
+    stack.emplace_back(root, g.start[root]);
+    int tree_edges = 0;
+    while (!stack.empty()) {
+      auto &[i, e] = stack.back();
+      if (e == g.start[i + 1]) {
+        f.order.push_back(i);
+        stack.pop_back();
+        continue;
+      }
+      const int other = g.neighbour[e], c = g.contact[e];
+      ++e;
+      if (!in_tree[c] || seen[other]) continue;
+      seen[other] = 1;
+      f.parent[other] = i;
+      f.parent_contact[other] = c;
+      ++tree_edges;
+      stack.emplace_back(other, g.start[other]);
+    }
+    if (tree_edges == 0) continue;
+    ++f.stats.num_fibres;
+    if (static_cast<int>(f.stats.length_histogram.size()) <= tree_edges)
+      f.stats.length_histogram.resize(tree_edges + 1, 0);
+    ++f.stats.length_histogram[tree_edges];
+  }
+  return f;
+}
+
+}  // namespace fibre

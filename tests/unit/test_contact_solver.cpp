@@ -1,0 +1,361 @@
+// solve_step on hand-built systems with known answers (spheres resting, stacked, pulled,
+// separating), conservation laws, and agreement between forms and solvers.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+
+#include "fibre/contact_solver.hpp"
+#include "fibre/kernels.hpp"
+#include "fibre/scenes.hpp"
+
+using namespace fibre;
+
+namespace {
+
+constexpr double kG = 9.81;
+constexpr double kH = 1e-3;
+
+SpookParams spook()
+{
+  SpookParams p;
+  p.h = kH;
+  p.damping = 2.0;
+  return p;
+}
+
+// eps 1e-14 gives Sigma ~ 4e-9: the regularization shifts impulses by ~1e-8 relative.
+ContactSystem make_system(const std::vector<Body> &bodies, std::vector<Contact> contacts,
+                          int rows, double eps = 1e-14)
+{
+  for (Contact &c : contacts) c.compliance.fill(eps);
+  return ContactSystem(bodies, std::move(contacts), rows, spook());
+}
+
+Body sphere(double mass, double radius, const Vec3 &x)
+{
+  Body b;
+  b.mass = mass;
+  b.radius = radius;
+  b.x = x;
+  b.force = Vec3(0, 0, -kG * mass);
+  return b;
+}
+
+// Every form x solver, block preconditioner, tight tolerance.
+std::vector<StepOptions> all_options()
+{
+  std::vector<StepOptions> out;
+  for (Form form : {Form::contact, Form::body})
+    for (SolverKind s : {SolverKind::uzawa, SolverKind::cr, SolverKind::minres,
+                         SolverKind::direct}) {
+      StepOptions o;
+      o.form = form;
+      o.solver = s;
+      o.stop.tol = 1e-11;
+      o.stop.max_iter = 5000;
+      o.active_set_max = 10;
+      out.push_back(o);
+    }
+  return out;
+}
+
+std::string label(const StepOptions &o)
+{
+  return std::string(to_string(o.form)) + " " + to_string(o.solver);
+}
+
+StepResult solve(ContactSystem &sys, const StepOptions &o, const Vector *warm = nullptr)
+{
+  return solve_step(sys, serial_exchange(), o, warm, MPI_COMM_SELF);
+}
+
+double rel_diff(const Vector &a, const Vector &b)
+{
+  return (a - b).norm() / std::max(b.norm(), 1e-300);
+}
+
+}  // namespace
+
+TEST(ContactSolver, SolverNames)
+{
+  for (SolverKind s : {SolverKind::uzawa, SolverKind::cr, SolverKind::minres,
+                       SolverKind::direct}) {
+    SolverKind back;
+    ASSERT_TRUE(parse_solver(to_string(s), back));
+    EXPECT_EQ(back, s);
+  }
+  SolverKind k;
+  EXPECT_TRUE(parse_solver("mumps", k));
+  EXPECT_EQ(k, SolverKind::direct);
+  EXPECT_FALSE(parse_solver("jacobi", k));
+}
+
+// A sphere resting on the floor: lambda_n = h m g, no tangential or rotational impulse.
+TEST(ContactSolver, SphereRestingOnFloor)
+{
+  const double m = 2.0;
+  for (int rows : {3, 6}) {
+    const std::vector<Body> bodies{sphere(m, 0.5, Vec3(0.3, -0.2, 0.5))};
+    ContactSystem sys =
+        make_system(bodies, {sphere_wall_contact(bodies, 0, Vec3::UnitZ(), 0.5)}, rows);
+    for (const StepOptions &o : all_options()) {
+      SCOPED_TRACE(label(o) + " rows " + std::to_string(rows));
+      const StepResult r = solve(sys, o);
+      EXPECT_TRUE(r.converged);
+      EXPECT_NEAR(r.lambda[0], kH * m * kG, 1e-6 * kH * m * kG);
+      for (int i = 1; i < rows; ++i) EXPECT_NEAR(r.lambda[i], 0.0, 1e-10 * kH * m * kG);
+      // The contact cancels gravity's velocity change.
+      EXPECT_NEAR(r.dv[2], kH * kG, 1e-6 * kH * kG);
+      EXPECT_EQ(r.released, 0);
+      EXPECT_EQ(r.capped, 0);
+      EXPECT_TRUE(r.set_settled);
+      EXPECT_EQ(r.active_set_passes, 1);
+    }
+  }
+}
+
+// A column of three spheres on the floor: each contact carries h g (mass above it).
+TEST(ContactSolver, ColumnOfThreeSpheres)
+{
+  const double m[3] = {1.0, 2.0, 3.0}, r = 0.5;
+  std::vector<Body> bodies;
+  for (int i = 0; i < 3; ++i) bodies.push_back(sphere(m[i], r, Vec3(0, 0, r + 2 * r * i)));
+  std::vector<Contact> contacts{sphere_wall_contact(bodies, 0, Vec3::UnitZ(), r),
+                                sphere_sphere_contact(bodies, 1, 0),
+                                sphere_sphere_contact(bodies, 2, 1)};
+  const double above[3] = {6.0, 5.0, 3.0};
+  for (int rows : {3, 6}) {
+    ContactSystem sys = make_system(bodies, contacts, rows);
+    for (const StepOptions &o : all_options()) {
+      SCOPED_TRACE(label(o) + " rows " + std::to_string(rows));
+      const StepResult res = solve(sys, o);
+      EXPECT_TRUE(res.converged);
+      for (int c = 0; c < 3; ++c) {
+        EXPECT_NEAR(res.lambda[rows * c], kH * kG * above[c], 1e-6 * kH * kG * above[c]);
+        for (int i = 1; i < rows; ++i) EXPECT_NEAR(res.lambda[rows * c + i], 0.0, 1e-9);
+      }
+      for (int i = 0; i < 3; ++i) EXPECT_NEAR(res.dv[6 * i + 2], kH * kG, 1e-6 * kH * kG);
+    }
+  }
+}
+
+// A sphere pulled sideways by F at its centre. With rolling resistance (rows 6, mu_roll
+// large) it sticks below mu m g: the friction impulse is -h F. Above it slides: |lambda_t|
+// = mu lambda_n against the pull. Without rotational rows (rows 3) it rolls: a solid sphere
+// then needs friction 2F/7 only.
+TEST(ContactSolver, PulledSphereSticksOrSlides)
+{
+  const double m = 1.5, r = 0.4, mu = 0.5;
+  struct Case {
+    int rows;
+    double pull;      // F / (m g)
+    double friction;  // expected lambda_t1 / (h m g); t1 = x for a floor contact
+  };
+  const Case cases[] = {
+      {6, 0.3, -0.3},       // sticks
+      {6, 0.8, -mu},        // slides
+      {3, 0.2, -0.2 * 2 / 7},  // rolls without slipping
+      {3, 3.0, -mu},        // rolls and slips
+  };
+  for (const Case &cs : cases) {
+    std::vector<Body> bodies{sphere(m, r, Vec3(0, 0, r))};
+    bodies[0].force.x() = cs.pull * m * kG;
+    ContactSystem sys =
+        make_system(bodies, {sphere_wall_contact(bodies, 0, Vec3::UnitZ(), r)}, cs.rows);
+    ASSERT_NEAR(sys.contacts()[0].t1.x(), 1.0, 1e-15);
+    for (StepOptions o : all_options()) {
+      o.friction.mu = mu;
+      o.friction.mu_roll = 1.0;
+      SCOPED_TRACE(label(o) + " rows " + std::to_string(cs.rows) + " pull " +
+                   std::to_string(cs.pull));
+      const StepResult res = solve(sys, o);
+      EXPECT_TRUE(res.converged);
+      EXPECT_TRUE(res.set_settled);
+      const double hmg = kH * m * kG;
+      EXPECT_NEAR(res.lambda[0], hmg, 1e-6 * hmg);
+      EXPECT_NEAR(res.lambda[1], cs.friction * hmg, 1e-6 * hmg);
+      EXPECT_NEAR(res.lambda[2], 0.0, 1e-9 * hmg);
+      const bool slides = cs.friction == -mu;
+      EXPECT_EQ(res.capped, slides ? 2 : 0);
+      if (cs.rows == 6 && !slides) {
+        EXPECT_NEAR(res.dv[0], -kH * cs.pull * kG, 1e-6 * kH * kG);
+      }
+    }
+  }
+}
+
+// Two spheres flying apart with a positive gap are released; approaching ones are not.
+TEST(ContactSolver, SeparatingPairIsReleased)
+{
+  for (double speed : {1.0, -1.0}) {
+    std::vector<Body> bodies{sphere(1.0, 1.0, Vec3(0, 0, 2.001)), sphere(2.0, 1.0, Vec3::Zero())};
+    for (Body &b : bodies) b.force.setZero();
+    bodies[0].v = Vec3(0, 0, speed);
+    bodies[1].v = Vec3(0, 0, -speed);
+    ContactSystem sys = make_system(bodies, {sphere_sphere_contact(bodies, 0, 1)}, 6);
+    ASSERT_GT(sys.contacts()[0].gap, 0.0);
+    for (const StepOptions &o : all_options()) {
+      SCOPED_TRACE(label(o) + (speed > 0 ? " apart" : " closing"));
+      const StepResult res = solve(sys, o);
+      if (speed > 0) {
+        EXPECT_EQ(res.lambda.norm(), 0.0);
+        EXPECT_EQ(res.dv.norm(), 0.0);
+        EXPECT_EQ(res.released, 1);
+      } else {
+        EXPECT_GT(res.lambda[0], 0.0);
+        EXPECT_EQ(res.released, 0);
+      }
+    }
+  }
+}
+
+// Body-body contacts only: the impulses are internal, momentum and angular momentum stay.
+TEST(ContactSolver, ConservesMomentum)
+{
+  SceneParams p;
+  p.seed = 3;
+  const ContactSystem pile = pile_scene(60, p);
+  std::vector<Contact> internal;
+  for (const Contact &c : pile.contacts())
+    if (!c.is_wall()) internal.push_back(c);
+  ASSERT_GT(internal.size(), 30u);
+  ContactSystem sys(pile.bodies(), internal, 6, pile.params());
+  for (StepOptions o : all_options()) {
+    o.friction.mu_roll = 0.05;
+    o.friction.mu_twist = 0.05;
+    o.stop.tol = 1e-6;  // conservation must not depend on the accuracy
+    SCOPED_TRACE(label(o));
+    const StepResult res = solve(sys, o);
+    Vec3 momentum = Vec3::Zero(), angular = Vec3::Zero();
+    double scale = 0, angular_scale = 0;
+    for (int i = 0; i < sys.num_bodies(); ++i) {
+      const Body &b = sys.bodies()[i];
+      const Vec3 dp = b.mass * res.dv.segment<3>(6 * i);
+      const Vec3 dl = 0.4 * b.mass * b.radius * b.radius * res.dv.segment<3>(6 * i + 3) +
+                      b.x.cross(dp);
+      momentum += dp;
+      angular += dl;
+      scale += dp.norm();
+      angular_scale += dl.norm();
+    }
+    ASSERT_GT(scale, 0.0);
+    EXPECT_LT(momentum.norm(), 1e-13 * scale);
+    EXPECT_LT(angular.norm(), 1e-13 * angular_scale);
+  }
+}
+
+// Final impulses are feasible, and once the set has settled they satisfy the contact
+// conditions: active rows solved, released contacts do not press, capped cones slip.
+TEST(ContactSolver, FeasibleAndConsistentOnPile)
+{
+  SceneParams p;
+  p.seed = 11;
+  ContactSystem sys = pile_scene(80, p);
+  const int rows = sys.rows();
+  for (StepOptions o : all_options()) {
+    o.friction.mu = 0.4;
+    o.friction.mu_roll = 0.02;
+    o.friction.mu_twist = 0.02;
+    o.active_set_max = 60;
+    SCOPED_TRACE(label(o));
+    const StepResult res = solve(sys, o);
+    ASSERT_TRUE(res.lambda.allFinite());
+    EXPECT_TRUE(res.converged);
+    EXPECT_TRUE(res.set_settled);
+    EXPECT_GT(res.capped, 0);
+    // The row mask is back to all rows, the rhs to the full SPOOK rhs.
+    for (unsigned char a : sys.row_mask()) EXPECT_EQ(a, 1);
+    const Vector b = spook_rhs(sys);
+    EXPECT_LT(rel_diff(sys.rhs(), b), 1e-15);
+    Vector G_dv;
+    g_apply(sys, res.dv, G_dv);
+    const Vector rho = b - G_dv - sys.sigma().cwiseProduct(res.lambda);
+    const double tol = 1e-5 * b.norm();
+    int released = 0;
+    for (int c = 0; c < sys.num_contacts(); ++c) {
+      const Eigen::Index k = Eigen::Index(rows) * c;
+      const double ln = res.lambda[k];
+      ASSERT_GE(ln, 0.0);
+      if (ln == 0) {
+        ++released;
+        EXPECT_LE(rho[k], tol) << "released contact " << c << " would press";
+        continue;
+      }
+      EXPECT_NEAR(rho[k], 0.0, tol) << "normal row of contact " << c;
+      const double r_eff = sys.contacts()[c].is_wall()
+          ? sys.bodies()[sys.contacts()[c].a].radius
+          : 1.0 / (1.0 / sys.bodies()[sys.contacts()[c].a].radius +
+                   1.0 / sys.bodies()[sys.contacts()[c].b].radius);
+      const struct {
+        int first, size;
+        double radius;
+      } cones[3] = {{1, 2, o.friction.mu * ln},
+                    {3, 1, o.friction.mu_twist * r_eff * ln},
+                    {4, 2, o.friction.mu_roll * r_eff * ln}};
+      for (const auto &cone : cones) {
+        const Vector t = res.lambda.segment(k + cone.first, cone.size);
+        const Vector q = rho.segment(k + cone.first, cone.size);
+        EXPECT_LE(t.norm(), cone.radius * (1 + 1e-12)) << "cone of contact " << c;
+        if (t.norm() < cone.radius * (1 - 1e-9)) {
+          EXPECT_LT(q.norm(), tol) << "sticking cone of contact " << c;
+        }
+      }
+    }
+    EXPECT_EQ(released, res.released);
+  }
+}
+
+// Forms and solvers agree on the same step, and a warm start from the answer is cheap.
+TEST(ContactSolver, FormsAndSolversAgree)
+{
+  SceneParams p;
+  p.seed = 5;
+  ContactSystem sys = pile_scene(60, p);
+  StepOptions ref_opt;
+  ref_opt.form = Form::contact;
+  ref_opt.solver = SolverKind::direct;
+  ref_opt.active_set_max = 60;
+  const StepResult ref = solve(sys, ref_opt);
+  ASSERT_TRUE(ref.set_settled);
+  for (StepOptions o : all_options()) {
+    o.active_set_max = 60;
+    for (PrecondKind kind : {PrecondKind::none, PrecondKind::block, PrecondKind::fibre,
+                             PrecondKind::tree}) {
+      if (o.solver == SolverKind::direct && kind != PrecondKind::none) continue;
+      o.precond.kind = kind;
+      SCOPED_TRACE(label(o) + " " + to_string(kind));
+      const StepResult res = solve(sys, o);
+      EXPECT_TRUE(res.converged);
+      EXPECT_LT(rel_diff(res.dv, ref.dv), 1e-6);
+      EXPECT_LT(rel_diff(res.lambda, ref.lambda), 1e-5);
+      EXPECT_EQ(res.released, ref.released);
+      EXPECT_EQ(res.capped, ref.capped);
+      if (o.solver != SolverKind::direct) {
+        const StepResult again = solve(sys, o, &res.lambda);
+        // Fewer passes (the caps start where they were) and fewer iterations; the answer moves
+        // within the caps' settling tolerance (cap_tol = 1e-6 of the largest impulse).
+        EXPECT_LT(again.active_set_passes, res.active_set_passes);
+        EXPECT_LT(again.total_iterations, res.total_iterations);
+        EXPECT_LT(rel_diff(again.dv, res.dv), 1e-5);
+      }
+    }
+  }
+}
+
+// Non-finite input: the result stays finite and says it did not converge.
+TEST(ContactSolver, NonFiniteInputGivesFiniteResult)
+{
+  SceneParams p;
+  ContactSystem pile = pile_scene(30, p);
+  std::vector<Body> bodies = pile.bodies();
+  bodies[4].v.x() = std::numeric_limits<double>::quiet_NaN();
+  ContactSystem sys(bodies, pile.contacts(), 6, pile.params());
+  for (const StepOptions &o : all_options()) {
+    SCOPED_TRACE(label(o));
+    const StepResult res = solve(sys, o);
+    EXPECT_FALSE(res.converged);
+    EXPECT_TRUE(res.lambda.allFinite());
+    EXPECT_TRUE(res.dv.allFinite());
+  }
+}
