@@ -696,7 +696,7 @@ void FixFibreContact::warm_start(const std::vector<Found> &found, int rows,
     const fibre::Contact &k = fc.contact;
     const fibre::Vec3 dirs[3] = {k.normal, k.t1, k.t2};
     for (int r = 0; r < rows; ++r)
-      warm[Eigen::Index(rows) * c + r] = (r > 0 && std::getenv("FIBRE_WS") ? 0.99 : 1.0) * dtv_ * (r < 3 ? force.dot(dirs[r]) : moment.dot(dirs[r - 3]));
+      warm[Eigen::Index(rows) * c + r] = dtv_ * (r < 3 ? force.dot(dirs[r]) : moment.dot(dirs[r - 3]));
   }
 }
 
@@ -924,7 +924,7 @@ void FixFibreContact::final_integrate()
   try {
     sys = std::make_unique<fibre::ContactSystem>(std::move(bodies), std::move(contacts), rows_,
                                                  params, exchange_->num_owned());
-    res = fibre::solve_step(*sys, *exchange_, opt_, std::getenv("FIBRE_NO_WARM") ? nullptr : &warm, world);
+    res = fibre::solve_step(*sys, *exchange_, opt_, &warm, world);
   } catch (std::exception &e) {
     error->one(FLERR, std::string("Fix fibre_contact: contact solver failed at step ") +
                           std::to_string(static_cast<long long>(update->ntimestep)) + ": " +

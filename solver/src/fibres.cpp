@@ -72,18 +72,51 @@ double static_weight(const ContactSystem &sys, EdgeWeight weight, const Vector *
   return std::abs(sys.bodies()[k.a].x.z() - sys.bodies()[k.b].x.z());
 }
 
+// Edge weights for the walk, on flat copies of the positions (the walk's inner loop).
+class WalkWeight {
+ public:
+  WalkWeight(const ContactSystem &sys, EdgeWeight weight, const Vector *impulses)
+      : weight_(impulses || weight != EdgeWeight::impulse ? weight : EdgeWeight::z),
+        impulses_(impulses ? impulses->data() : nullptr), pos_(3 * std::size_t(sys.num_bodies()))
+  {
+    for (int i = 0; i < sys.num_bodies(); ++i)
+      for (int d = 0; d < 3; ++d) pos_[3 * std::size_t(i) + d] = sys.bodies()[i].x[d];
+  }
+  // Contact c from body `from` to `to`; prev: the previous edge of the fibre, or zero.
+  double operator()(int c, int from, int to, const Vec3 &prev) const
+  {
+    const double *x = &pos_[3 * std::size_t(from)], *y = &pos_[3 * std::size_t(to)];
+    switch (weight_) {
+      case EdgeWeight::z: return std::abs(y[2] - x[2]);
+      case EdgeWeight::impulse: return -impulses_[c];
+      case EdgeWeight::straight: break;
+    }
+    const double pn = prev.squaredNorm();
+    if (pn == 0) return 0.0;  // first edge of a fibre: no preference
+    const Vec3 e(y[0] - x[0], y[1] - x[1], y[2] - x[2]);
+    const double norms = std::sqrt(e.squaredNorm() * pn);
+    return norms > 0 ? 1.0 - std::abs(e.dot(prev)) / norms : 1.0;
+  }
+  Vec3 direction(int from, int to) const
+  {
+    const double *x = &pos_[3 * std::size_t(from)], *y = &pos_[3 * std::size_t(to)];
+    return Vec3(y[0] - x[0], y[1] - x[1], y[2] - x[2]);
+  }
+
+ private:
+  EdgeWeight weight_;
+  const double *impulses_;
+  std::vector<double> pos_;
+};
+
 }  // namespace
 
 double edge_weight(const ContactSystem &sys, EdgeWeight weight, const Vector *impulses, int c,
                    int from, const Vec3 &prev_dir)
 {
-  if (weight != EdgeWeight::straight) return static_weight(sys, weight, impulses, c);
-  if (prev_dir.isZero()) return 0.0;  // first edge of a fibre: no preference
+  check_impulses(sys, weight, impulses);
   const Contact &k = sys.contacts()[c];
-  const int to = k.a == from ? k.b : k.a;
-  const Vec3 e = sys.bodies()[to].x - sys.bodies()[from].x;
-  const double norms = e.norm() * prev_dir.norm();
-  return norms > 0 ? 1.0 - std::abs(e.dot(prev_dir)) / norms : 1.0;
+  return WalkWeight(sys, weight, impulses)(c, from, k.a == from ? k.b : k.a, prev_dir);
 }
 
 Fibres build_fibres(const ContactSystem &sys, EdgeWeight weight, const Vector *impulses,
@@ -91,7 +124,7 @@ Fibres build_fibres(const ContactSystem &sys, EdgeWeight weight, const Vector *i
 {
   check_impulses(sys, weight, impulses);
   const ContactGraph g = contact_graph(sys, include_ghosts);
-  const std::vector<Body> &bodies = sys.bodies();
+  const WalkWeight cost(sys, weight, impulses);
   const int nb = sys.num_bodies();
   std::vector<char> taken(nb, 0);
 
@@ -102,7 +135,7 @@ Fibres build_fibres(const ContactSystem &sys, EdgeWeight weight, const Vector *i
     for (int e = g.start[cur]; e < g.start[cur + 1]; ++e) {
       const int other = g.neighbour[e], c = g.contact[e];
       if (taken[other]) continue;
-      const double w = edge_weight(sys, weight, impulses, c, cur, prev_dir);
+      const double w = cost(c, cur, other, prev_dir);
       if (via < 0 || w < best || (w == best && c < via)) {
         best = w;
         via = c;
@@ -114,6 +147,8 @@ Fibres build_fibres(const ContactSystem &sys, EdgeWeight weight, const Vector *i
 
   Fibres f;
   f.stats.num_contacts = g.num_edges;
+  f.bodies.reserve(nb);
+  f.contacts.reserve(nb);
   std::vector<int> back_bodies, back_contacts;
   for (int s = 0; s < nb; ++s) {
     int next = -1, via = -1;
@@ -128,18 +163,18 @@ Fibres build_fibres(const ContactSystem &sys, EdgeWeight weight, const Vector *i
       taken[next] = 1;
       f.bodies.push_back(next);
       f.contacts.push_back(via);
-      prev_dir = bodies[next].x - bodies[cur].x;
+      prev_dir = cost.direction(cur, next);
       cur = next;
     } while (step(cur, prev_dir, next, via));
     back_bodies.clear();
     back_contacts.clear();
     cur = s;
-    prev_dir = bodies[f.bodies[body_base + 1]].x - bodies[s].x;
+    prev_dir = cost.direction(s, f.bodies[body_base + 1]);
     while (step(cur, prev_dir, next, via)) {
       taken[next] = 1;
       back_bodies.push_back(next);
       back_contacts.push_back(via);
-      prev_dir = bodies[next].x - bodies[cur].x;
+      prev_dir = cost.direction(cur, next);
       cur = next;
     }
     f.bodies.insert(f.bodies.begin() + body_base, back_bodies.rbegin(), back_bodies.rend());

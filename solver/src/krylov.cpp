@@ -92,7 +92,7 @@ class Session {
 
   // Bookkeeping after iteration k (k = 0: the initial or restart residual, which is true).
   // r_norm: ||r|| of the (updated) residual; rPr: r^T P^-1 r as the method knows it;
-  // trust_rPr: a small rPr alone triggers the true-residual check (MINRES).
+  // trust_rPr: rPr is an estimate that may trigger the true-residual check (MINRES).
   Next step(int k, const Vector &x, double r_norm, double rPr, bool is_true,
             bool trust_rPr = false)
   {
@@ -103,7 +103,6 @@ class Session {
     const double rel = r_norm / b_norm_;
     record(k, x, rel, rPr);
     if (!std::isfinite(rel) || !std::isfinite(rPr)) return stop_now(StopReason::non_finite);
-    if (rPr < 0) return stop_now(StopReason::breakdown);  // P is not positive definite
     if (k > 0 && stop_.accept && stop_.accept(k, x)) return stop_now(StopReason::converged);
     // MINRES's estimate counts once its updated residual has levelled off: no new minimum
     // for kLevelOff iterations (with a preconditioner the two norms differ).
@@ -125,6 +124,8 @@ class Session {
       if (k >= stop_.max_iter) return stop_now(StopReason::max_iterations);
       return Next::restart;
     }
+    // Checked after convergence: at round-off level r^T P^-1 r is noise of either sign.
+    if (rPr < 0) return stop_now(StopReason::breakdown);  // P is not positive definite
     if (k >= stop_.max_iter) return stop_now(StopReason::max_iterations);
     return Next::iterate;
   }
@@ -147,7 +148,8 @@ class Session {
 
   SolveResult finish(Vector &x)
   {
-    // The guards keep x finite; this is the last line of defence (a non-finite operator).
+    // The scalar guards stop before anything non-finite enters x, so x is the last finite
+    // iterate; this is the last line of defence (e.g. an operator returning Inf silently).
     if (!std::isfinite(A_.dot(x, x))) {
       x = x0_;
       true_valid_ = false;
@@ -194,7 +196,7 @@ class Session {
   const Vector &b_;
   const StopControl &stop_;
   const KrylovMonitor *monitor_;
-  Vector x0_;      // the last finite iterate we can always return to
+  Vector x0_;                // finite fallback should x ever turn non-finite
   Vector r_true_;            // b - A x when have_true_
   bool have_true_ = false;   // r_true_ belongs to the current x
   bool true_valid_ = false;  // true_norm_ belongs to the current x
@@ -344,8 +346,9 @@ SolveResult minres(const LinearOperator &A, const Preconditioner &P, const Vecto
     oldb = beta;
     const double beta2 = A.dot(r2, y);
     if (!s.finite(alpha) || !s.finite(beta2)) break;
-    if (beta2 < 0 && !s.positive(beta2)) break;  // P is not positive definite
-    beta = std::sqrt(beta2);
+    // Negative beyond round-off: P is not positive definite. At round-off: Lanczos is done.
+    if (beta2 < -1e-14 * oldb * oldb && !s.positive(beta2)) break;
+    beta = std::sqrt(std::max(beta2, 0.0));
     // Apply the previous rotation, then the new one that annihilates beta.
     const double oldeps = epsln;
     const double delta = cs * dbar + sn * alpha;

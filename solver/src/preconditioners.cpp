@@ -42,82 +42,81 @@ namespace {
 using RowMat6 = Eigen::Matrix<double, 6, 6, Eigen::RowMajor>;
 
 constexpr int kB = 6;
-constexpr int kBlock = kB * kB;
+constexpr int kPacked = 21;  // lower triangle of a 6x6 block
+constexpr int kBlock = 36;
 
-// ---- 6x6 kernels ----
+// Packed lower triangle, column by column: (i, j), i >= j.
+constexpr int at(int i, int j) { return j * kB - j * (j - 1) / 2 + (i - j); }
+
+// ---- 6x6 kernels (fully unrolled: every index below is a compile-time constant) ----
 //
-// A Cholesky factor L (column-major, l[i + 6 j]) keeps 1 / L_jj on its diagonal so that the
-// solves only multiply. Coupling blocks W are row-major (w[6 i + j]) so that the loops below
-// run over contiguous memory.
-
-void cholesky6(double *a)
+// D = L Delta L^T in place (packed): L unit lower below the diagonal, 1 / Delta on it. No
+// square roots: on these tiny blocks the sqrt/divide chain is the cost of a Cholesky.
+inline void ldlt6(double *a)
 {
+  double delta[kB];
   FIBRE_UNROLL
   for (int j = 0; j < kB; ++j) {
-    double d = a[j + kB * j];
-    for (int k = 0; k < j; ++k) d -= a[j + kB * k] * a[j + kB * k];
+    double t[kB];  // L_jk Delta_k
+    double d = a[at(j, j)];
+    FIBRE_UNROLL
+    for (int k = 0; k < j; ++k) {
+      t[k] = a[at(j, k)] * delta[k];
+      d -= t[k] * a[at(j, k)];
+    }
     if (!(d > 0)) throw std::runtime_error("preconditioner block is not positive definite");
-    const double inv = 1.0 / std::sqrt(d);
-    a[j + kB * j] = inv;
+    delta[j] = d;
+    const double inv = 1.0 / d;
+    a[at(j, j)] = inv;
+    FIBRE_UNROLL
     for (int i = j + 1; i < kB; ++i) {
-      double s = a[i + kB * j];
-      for (int k = 0; k < j; ++k) s -= a[i + kB * k] * a[j + kB * k];
-      a[i + kB * j] = s * inv;
+      double s = a[at(i, j)];
+      FIBRE_UNROLL
+      for (int k = 0; k < j; ++k) s -= a[at(i, k)] * t[k];
+      a[at(i, j)] = s * inv;
     }
   }
 }
 
-// x = L^-1 x.
-inline void lower_solve6(const double *l, double *x)
+// x = L^-1 x (unit lower).
+inline void unit_lower_solve6(const double *l, double *x)
 {
   FIBRE_UNROLL
-  for (int i = 0; i < kB; ++i) {
+  for (int i = 1; i < kB; ++i) {
     double s = x[i];
-    for (int k = 0; k < i; ++k) s -= l[i + kB * k] * x[k];
-    x[i] = s * l[i + kB * i];
+    FIBRE_UNROLL
+    for (int k = 0; k < i; ++k) s -= l[at(i, k)] * x[k];
+    x[i] = s;
   }
 }
 
-// x = L^-T x.
-inline void upper_solve6(const double *l, double *x)
+// x = L^-T x (unit upper).
+inline void unit_upper_solve6(const double *l, double *x)
 {
   FIBRE_UNROLL
-  for (int i = kB - 1; i >= 0; --i) {
+  for (int i = kB - 2; i >= 0; --i) {
     double s = x[i];
-    for (int k = i + 1; k < kB; ++k) s -= l[k + kB * i] * x[k];
-    x[i] = s * l[i + kB * i];
-  }
-}
-
-// W = L^-1 W for a row-major W: forward substitution on whole rows.
-inline void lower_solve_rows6(const double *l, double *w)
-{
-  FIBRE_UNROLL
-  for (int i = 0; i < kB; ++i) {
-    double *wi = w + kB * i;
-    for (int k = 0; k < i; ++k) {
-      const double lik = l[i + kB * k];
-      const double *wk = w + kB * k;
-      for (int j = 0; j < kB; ++j) wi[j] -= lik * wk[j];
-    }
-    const double inv = l[i + kB * i];
-    for (int j = 0; j < kB; ++j) wi[j] *= inv;
+    FIBRE_UNROLL
+    for (int k = i + 1; k < kB; ++k) s -= l[at(k, i)] * x[k];
+    x[i] = s;
   }
 }
 
 // ---- Block LDL^T of a matrix whose block graph is a forest ----
 //
 // Nodes are 6x6 blocks, ordered so that every node comes before its parent (leaves first);
-// eliminating in that order creates no fill. Node n holds D_n = sign_n L_n L_n^T and the
-// block B_n = A(n, parent). A path of nodes is the block Thomas algorithm, isolated nodes
-// are the block diagonal. With sign -1 nodes the same code eliminates the augmented
-// (quasi-definite) system [-M -G^T; -G Sigma] of a contact tree: there every pivot keeps its
-// sign, so no pivoting is needed.
+// eliminating in that order creates no fill. Node n holds D_n = sign_n L_n Delta_n L_n^T and
+// the block B_n = A(n, parent), replaced by V_n = L_n^-1 B_n (row-major). A path of nodes is
+// the block Thomas algorithm, isolated nodes are the block diagonal. With sign -1 nodes the
+// same code eliminates the augmented (quasi-definite) system [-M -G^T; -G Sigma] of a contact
+// tree: there every pivot keeps its sign, so no pivoting is needed.
 class ForestFactor {
  public:
+  // The coupling storage is reserved for every node but only touched for nodes with a
+  // parent (the pages of the others are never written).
   ForestFactor(int nodes, int dim)
       : dim_(dim), parent_(nodes, -1), offset_(nodes, -1), sign_(nodes, 1),
-        l_(new double[std::size_t(kBlock) * nodes]), w_(new double[std::size_t(kBlock) * nodes])
+        l_(new double[std::size_t(kPacked) * nodes]), w_(new double[std::size_t(kBlock) * nodes])
   {
   }
   int nodes() const { return static_cast<int>(parent_.size()); }
@@ -129,9 +128,26 @@ class ForestFactor {
     parent_[n] = parent;
     sign_[n] = static_cast<signed char>(sign);
   }
-  // sign_n D_n before factor() (positive definite; only the lower triangle is read).
-  Eigen::Map<Mat6> diag(int n) { return Eigen::Map<Mat6>(l_.get() + std::size_t(kBlock) * n); }
-  // B_n = A(n, parent) before factor().
+  // sign_n D_n (positive definite; the lower triangle is read).
+  void set_diag(int n, const Mat6 &d)
+  {
+    double *l = l_.get() + std::size_t(kPacked) * n;
+    FIBRE_UNROLL
+    for (int j = 0; j < kB; ++j)
+      FIBRE_UNROLL
+      for (int i = j; i < kB; ++i) l[at(i, j)] = d(i, j);
+  }
+  // Packed lower triangle of sign_n D_n, to be filled in place.
+  double *diag_data(int n) { return l_.get() + std::size_t(kPacked) * n; }
+  void set_diag(int n, const Vec6 &diagonal)
+  {
+    double *l = diag_data(n);
+    for (int k = 0; k < kPacked; ++k) l[k] = 0.0;
+    for (int i = 0; i < kB; ++i) l[at(i, i)] = diagonal[i];
+  }
+  // Row-major B_n, to be filled in place.
+  double *coupling_data(int n) { return w_.get() + std::size_t(kBlock) * n; }
+  // B_n = A(n, parent), for a node with a parent.
   Eigen::Map<RowMat6> coupling(int n)
   {
     return Eigen::Map<RowMat6>(w_.get() + std::size_t(kBlock) * n);
@@ -140,24 +156,37 @@ class ForestFactor {
   void factor()
   {
     for (int n = 0; n < nodes(); ++n) {
-      double *l = l_.get() + std::size_t(kBlock) * n;
-      cholesky6(l);
+      double *l = l_.get() + std::size_t(kPacked) * n;
+      ldlt6(l);
       const int p = parent_[n];
       if (p < 0) continue;
-      double *w = w_.get() + std::size_t(kBlock) * n;
-      lower_solve_rows6(l, w);  // W_n = L_n^-1 B_n
-      // D_p -= B_n^T D_n^-1 B_n = sign_n W_n^T W_n, in the parent's signed storage.
-      double *dp = l_.get() + std::size_t(kBlock) * p;
+      double *v = w_.get() + std::size_t(kBlock) * n;
+      // V = L^-1 B on whole rows.
+      FIBRE_UNROLL
+      for (int i = 1; i < kB; ++i)
+        FIBRE_UNROLL
+        for (int k = 0; k < i; ++k) {
+          const double lik = l[at(i, k)];
+          FIBRE_UNROLL
+          for (int j = 0; j < kB; ++j) v[kB * i + j] -= lik * v[kB * k + j];
+        }
+      // D_p -= B^T D_n^-1 B = sign_n V^T Delta^-1 V, in the parent's signed storage.
+      double sv[kBlock];
       const double s = double(sign_[n] * sign_[p]);
       FIBRE_UNROLL
-      for (int b = 0; b < kB; ++b) {
-        double *col = dp + kB * b;
-        for (int k = 0; k < kB; ++k) {
-          const double f = s * w[kB * k + b];
-          const double *wk = w + kB * k;
-          for (int a = 0; a < kB; ++a) col[a] -= f * wk[a];
+      for (int k = 0; k < kB; ++k)
+        FIBRE_UNROLL
+        for (int j = 0; j < kB; ++j) sv[kB * k + j] = s * l[at(k, k)] * v[kB * k + j];
+      double *dp = l_.get() + std::size_t(kPacked) * p;
+      FIBRE_UNROLL
+      for (int b = 0; b < kB; ++b)
+        FIBRE_UNROLL
+        for (int a = b; a < kB; ++a) {
+          double t = 0;
+          FIBRE_UNROLL
+          for (int k = 0; k < kB; ++k) t += sv[kB * k + a] * v[kB * k + b];
+          dp[at(a, b)] -= t;
         }
-      }
     }
   }
 
@@ -168,43 +197,50 @@ class ForestFactor {
     work.resize(std::size_t(kB) * nn);
     double *u = work.data();
     const double *rd = r.data();
+    // Forward: u_n = Delta_n^-1 L_n^-1 y_n, then y_p -= sign_n V_n^T u_n.
     for (int n = 0; n < nn; ++n) {
       double *un = u + kB * n;
-      for (int i = 0; i < kB; ++i) un[i] = 0.0;
       if (offset_[n] >= 0)
-        for (int i = 0; i < dim_; ++i) un[i] = rd[offset_[n] + i];
+        for (int i = 0; i < kB; ++i) un[i] = i < dim_ ? rd[offset_[n] + i] : 0.0;
+      else
+        for (int i = 0; i < kB; ++i) un[i] = 0.0;
     }
-    // Forward: u_n = L_n^-1 y_n, then y_p -= sign_n W_n^T u_n.
     for (int n = 0; n < nn; ++n) {
       double *un = u + kB * n;
-      lower_solve6(l_.get() + std::size_t(kBlock) * n, un);
+      const double *l = l_.get() + std::size_t(kPacked) * n;
+      unit_lower_solve6(l, un);
+      FIBRE_UNROLL
+      for (int i = 0; i < kB; ++i) un[i] *= l[at(i, i)];
       const int p = parent_[n];
       if (p < 0) continue;
-      const double *w = w_.get() + std::size_t(kBlock) * n;
+      const double *v = w_.get() + std::size_t(kBlock) * n;
       double *up = u + kB * p;
       const double s = sign_[n];
       FIBRE_UNROLL
       for (int k = 0; k < kB; ++k) {
         const double f = s * un[k];
-        for (int j = 0; j < kB; ++j) up[j] -= f * w[kB * k + j];
+        FIBRE_UNROLL
+        for (int j = 0; j < kB; ++j) up[j] -= f * v[kB * k + j];
       }
     }
-    // Backward, roots first: x_n = sign_n L_n^-T (u_n - W_n x_p), in place of u_n.
+    // Backward, roots first: x_n = sign_n L_n^-T (u_n - Delta_n^-1 V_n x_p), in place.
     double *zd = z.data();
     for (int n = nn - 1; n >= 0; --n) {
       double *un = u + kB * n;
+      const double *l = l_.get() + std::size_t(kPacked) * n;
       const int p = parent_[n];
       if (p >= 0) {
-        const double *w = w_.get() + std::size_t(kBlock) * n;
+        const double *v = w_.get() + std::size_t(kBlock) * n;
         const double *xp = u + kB * p;
         FIBRE_UNROLL
         for (int k = 0; k < kB; ++k) {
           double t = 0;
-          for (int j = 0; j < kB; ++j) t += w[kB * k + j] * xp[j];
-          un[k] -= t;
+          FIBRE_UNROLL
+          for (int j = 0; j < kB; ++j) t += v[kB * k + j] * xp[j];
+          un[k] -= l[at(k, k)] * t;
         }
       }
-      upper_solve6(l_.get() + std::size_t(kBlock) * n, un);
+      unit_upper_solve6(l, un);
       if (sign_[n] < 0)
         for (int k = 0; k < kB; ++k) un[k] = -un[k];
       if (offset_[n] >= 0)
@@ -217,8 +253,8 @@ class ForestFactor {
   std::vector<int> parent_;
   std::vector<int> offset_;
   std::vector<signed char> sign_;
-  std::unique_ptr<double[]> l_;  // 36 per node: D, then its factor
-  std::unique_ptr<double[]> w_;  // 36 per node with a parent: B, then W = L^-1 B
+  std::unique_ptr<double[]> l_;  // 21 per node: sign D, then its L Delta L^T factor
+  std::unique_ptr<double[]> w_;  // 36 per node, used by nodes with a parent
 };
 
 class ForestPreconditioner final : public Preconditioner {
@@ -266,26 +302,59 @@ std::unique_ptr<Preconditioner> finish(const char *name, ForestFactor f, Eigen::
 // ---- Blocks of A and K in closed form ----
 //
 // The Jacobian of contact c on its body j (side sign s: + for a, - for b) is
-// J = s [D, -Q D; 0, D] with D the frame (rows n, t1, t2) and Q = D [r]x D^T, r = p - x_j:
-// Q_ik = r . (d_k x d_i). Then, with mu = 1/m_j and iota = 1/I_j,
-//   J M^-1 J'^T = s s' [mu R - iota Q R Q', -iota Q R; iota R Q', iota R],  R = D D'^T,
-// which needs 3x3 products only (kernels.cpp forms the 6x6 blocks; this is the fast path).
+// J = s [D, -Q D; 0, D] with D the frame (rows d_0 = n, d_1 = t1, d_2 = t2) and
+// Q = D [r]x D^T antisymmetric, Q_ik = r . (d_k x d_i), r = p - x_j. With mu = 1/m_j and
+// iota = 1/I_j,
+//   J M^-1 J'^T = s s' [mu R - iota Q R Q', -iota Q R; iota R Q', iota R],   R = D D'^T,
+// so every block is a handful of 3x3 products (kernels.cpp forms the 6x6 products; these are
+// the fast paths, checked against the dense reference by the tests).
+
+using M3 = double[3][3];
+
+// The three numbers of an antisymmetric Q: (Q_01, Q_02, Q_12).
+struct Skew {
+  double a, b, c;
+};
+
+// X = Q M.
+inline void skew_left(const Skew &q, const M3 &m, M3 &x)
+{
+  for (int k = 0; k < 3; ++k) {
+    x[0][k] = q.a * m[1][k] + q.b * m[2][k];
+    x[1][k] = -q.a * m[0][k] + q.c * m[2][k];
+    x[2][k] = -q.b * m[0][k] - q.c * m[1][k];
+  }
+}
+
+// X = M Q.
+inline void skew_right(const M3 &m, const Skew &q, M3 &x)
+{
+  for (int i = 0; i < 3; ++i) {
+    x[i][0] = -q.a * m[i][1] - q.b * m[i][2];
+    x[i][1] = q.a * m[i][0] - q.c * m[i][2];
+    x[i][2] = q.b * m[i][0] + q.c * m[i][1];
+  }
+}
+
 class BlockBuilder {
  public:
   explicit BlockBuilder(const ContactSystem &sys)
-      : sys_(sys), rows_(sys.rows()), masked_(!sys.row_mask().empty())
+      : sys_(sys), rows_(sys.rows()), plain_(sys.row_mask().empty() && sys.rows() == kB)
   {
   }
 
-  Mat3 lever(int c, int side) const
+  void frame(int c, M3 &D) const
+  {
+    const Mat3 &F = sys_.kinematics(c).frame;
+    for (int i = 0; i < 3; ++i)
+      for (int k = 0; k < 3; ++k) D[i][k] = F(i, k);
+  }
+  Skew lever(int c, int side) const
   {
     const ContactKinematics &q = sys_.kinematics(c);
     const Vec3 &r = side == 0 ? q.ra : q.rb;
     const Vec3 d0 = q.frame.row(0), d1 = q.frame.row(1), d2 = q.frame.row(2);
-    const double q01 = r.dot(d1.cross(d0)), q02 = r.dot(d2.cross(d0)), q12 = r.dot(d2.cross(d1));
-    Mat3 Q;
-    Q << 0, q01, q02, -q01, 0, q12, -q02, -q12, 0;
-    return Q;
+    return {r.dot(d1.cross(d0)), r.dot(d2.cross(d0)), r.dot(d2.cross(d1))};
   }
   int body(int c, int side) const
   {
@@ -301,111 +370,163 @@ class BlockBuilder {
     for (int r = 0; r < rows_; ++r) w[r] = sys_.row_active(Eigen::Index(rows_) * c + r) ? 1 : 0;
     return w;
   }
-  // Zero the padding rows/columns (rows() == 3) and the masked ones.
-  void restrict(Mat6 &m, int c, int d) const
-  {
-    if (!masked_ && rows_ == kB) return;
-    m = weights(c).asDiagonal() * m * weights(d).asDiagonal();
-  }
 
-  // Diagonal block of A (identity on padding rows), as kernels.hpp's diagonal_block.
-  Mat6 contact_diag(int c) const
+  // Diagonal block of A (identity on padding rows, as kernels.hpp's diagonal_block), its
+  // lower triangle packed into l.
+  void contact_diag(int c, double *l) const
   {
-    Mat6 A = Mat6::Zero();
+    // Sums over the sides of mu I + iota Q Q^T (top left), iota Q (bottom left), iota I.
+    double t00 = 0, t11 = 0, t22 = 0, t10 = 0, t20 = 0, t21 = 0, qa = 0, qb = 0, qc = 0, ri = 0;
     const int sides = sys_.contacts()[c].is_wall() ? 1 : 2;
     for (int side = 0; side < sides; ++side) {
       const int j = body(c, side);
-      const Mat3 Q = lever(c, side);
+      const Skew q = lever(c, side);
       const double m = mu(j), i = iota(j);
-      A.topLeftCorner<3, 3>() += i * Q * Q.transpose();
-      A.topLeftCorner<3, 3>().diagonal().array() += m;
-      A.topRightCorner<3, 3>() -= i * Q;
-      A.bottomRightCorner<3, 3>().diagonal().array() += i;
+      t00 += m + i * (q.a * q.a + q.b * q.b);
+      t11 += m + i * (q.a * q.a + q.c * q.c);
+      t22 += m + i * (q.b * q.b + q.c * q.c);
+      t10 += i * q.b * q.c;
+      t20 -= i * q.a * q.c;
+      t21 += i * q.a * q.b;
+      qa += i * q.a;
+      qb += i * q.b;
+      qc += i * q.c;
+      ri += i;
     }
-    A.bottomLeftCorner<3, 3>() = A.topRightCorner<3, 3>().transpose();
-    restrict(A, c, c);
+    const double packed[kPacked] = {t00, t10, t20, 0,   -qa, -qb, t11, t21, qa, 0, -qc,
+                                    t22, qb,  qc,  0,   ri,  0,   0,   ri,  0,  ri};
+    for (int k = 0; k < kPacked; ++k) l[k] = packed[k];
+    if (!plain_) {
+      const Vec6 w = weights(c);
+      for (int j = 0; j < kB; ++j)
+        for (int i = j; i < kB; ++i) l[at(i, j)] *= w[i] * w[j];
+    }
     for (int r = 0; r < kB; ++r)
-      A(r, r) += r < rows_ ? sys_.sigma()[Eigen::Index(rows_) * c + r] : 1.0;
-    return A;
+      l[at(r, r)] += r < rows_ ? sys_.sigma()[Eigen::Index(rows_) * c + r] : 1.0;
+  }
+  Vec6 contact_diagonal(int c) const
+  {
+    double l[kPacked];
+    contact_diag(c, l);
+    Vec6 d;
+    for (int r = 0; r < kB; ++r) d[r] = l[at(r, r)];
+    return d;
   }
 
-  // A(c, d) for two contacts sharing bodies (coupling_block of kernels.hpp).
-  Mat6 contact_coupling(int c, int d) const
+  // A(c, d) for two contacts sharing bodies (coupling_block of kernels.hpp), row-major into w.
+  void contact_coupling(int c, int d, double *w) const
   {
-    Mat6 C = Mat6::Zero();
-    const Mat3 R = sys_.kinematics(c).frame * sys_.kinematics(d).frame.transpose();
+    M3 Dc, Dd, R, QR, RQ, QRQ;
+    frame(c, Dc);
+    frame(d, Dd);
+    for (int i = 0; i < 3; ++i)
+      for (int k = 0; k < 3; ++k)
+        R[i][k] = Dc[i][0] * Dd[k][0] + Dc[i][1] * Dd[k][1] + Dc[i][2] * Dd[k][2];
+    bool first = true;
     for (int sc = 0; sc < 2; ++sc)
       for (int sd = 0; sd < 2; ++sd) {
         const int j = body(c, sc);
         if (j < 0 || j != body(d, sd)) continue;
-        const Mat3 Qc = lever(c, sc), Qd = lever(d, sd);
+        const Skew qc = lever(c, sc), qd = lever(d, sd);
         const double s = sc == sd ? 1.0 : -1.0, m = s * mu(j), i = s * iota(j);
-        const Mat3 QcR = Qc * R;
-        C.topLeftCorner<3, 3>() += m * R - i * QcR * Qd;
-        C.topRightCorner<3, 3>() -= i * QcR;
-        C.bottomLeftCorner<3, 3>() += i * R * Qd;
-        C.bottomRightCorner<3, 3>() += i * R;
+        skew_left(qc, R, QR);
+        skew_right(R, qd, RQ);
+        skew_right(QR, qd, QRQ);
+        // w is uninitialised storage: the first shared body writes, a second one adds.
+        const bool add = !first;
+        first = false;
+        for (int r = 0; r < 3; ++r)
+          for (int k = 0; k < 3; ++k) {
+            double *top = w + kB * r, *bottom = w + kB * (r + 3);
+            const double tt = m * R[r][k] - i * QRQ[r][k], tr = -i * QR[r][k];
+            const double rt = i * RQ[r][k], rr = i * R[r][k];
+            top[k] = add ? top[k] + tt : tt;
+            top[k + 3] = add ? top[k + 3] + tr : tr;
+            bottom[k] = add ? bottom[k] + rt : rt;
+            bottom[k + 3] = add ? bottom[k + 3] + rr : rr;
+          }
       }
-    restrict(C, c, d);
-    return C;
+    if (first)
+      for (int k = 0; k < kBlock; ++k) w[k] = 0.0;
+    if (!plain_) {
+      const Vec6 wc = weights(c), wd = weights(d);
+      for (int r = 0; r < kB; ++r)
+        for (int k = 0; k < kB; ++k) w[kB * r + k] *= wc[r] * wd[k];
+    }
   }
 
-  // The Jacobian block G_cj (padded and masked rows zero), jacobian_block of kernels.hpp.
+  // The Jacobian block G_cj (padding and masked rows zero), jacobian_block of kernels.hpp.
   Mat6 jacobian(int c, int side) const
   {
-    const Mat3 &D = sys_.kinematics(c).frame;
+    M3 D, QD;
+    frame(c, D);
+    skew_left(lever(c, side), D, QD);
     const double s = side == 0 ? 1.0 : -1.0;
     Mat6 J;
-    J.topLeftCorner<3, 3>() = s * D;
-    J.topRightCorner<3, 3>() = -s * lever(c, side) * D;
-    J.bottomLeftCorner<3, 3>().setZero();
-    J.bottomRightCorner<3, 3>() = s * D;
-    if (masked_ || rows_ < kB) J = weights(c).asDiagonal() * J;
+    for (int r = 0; r < 3; ++r)
+      for (int k = 0; k < 3; ++k) {
+        J(r, k) = s * D[r][k];
+        J(r, k + 3) = -s * QD[r][k];
+        J(r + 3, k) = 0.0;
+        J(r + 3, k + 3) = s * D[r][k];
+      }
+    if (!plain_) J = weights(c).asDiagonal() * J;
     return J;
   }
 
   // Body-space parts of one contact: J_a^T Sigma^-1 J_a, J_b^T Sigma^-1 J_b and
   // K_ab = J_a^T Sigma^-1 J_b. With F = Q D and S_t, S_r the translational and rotational
-  // rows of Sigma^-1 (0 where masked),
+  // rows of Sigma^-1 (0 where masked or absent),
   //   J^T Sigma^-1 J' = s s' [D^T S_t D, -D^T S_t F'; -F^T S_t D, F^T S_t F' + D^T S_r D].
   void body_parts(int c, Mat6 &Kaa, Mat6 &Kbb, Mat6 &Kab) const
   {
-    const Mat3 &D = sys_.kinematics(c).frame;
-    const Vec6 w = weights(c);
-    Vec3 st, sr;
+    M3 D, Fa, Fb;
+    frame(c, D);
+    double st[3], sr[3];
+    const Vec6 w = plain_ ? Vec6::Ones() : weights(c);
+    const double *sigma = sys_.sigma().data() + std::size_t(rows_) * c;
     for (int r = 0; r < 3; ++r) {
-      st[r] = w[r] / sys_.sigma()[Eigen::Index(rows_) * c + r];
-      sr[r] = rows_ == kB ? w[r + 3] / sys_.sigma()[Eigen::Index(rows_) * c + r + 3] : 0.0;
+      st[r] = w[r] / sigma[r];
+      sr[r] = rows_ == kB ? w[r + 3] / sigma[r + 3] : 0.0;
     }
-    const Mat3 StD = st.asDiagonal() * D;
-    const Mat3 Pt = D.transpose() * StD, Pr = D.transpose() * sr.asDiagonal() * D;
-    const Mat3 Fa = lever(c, 0) * D;
-    const Mat3 DtStFa = StD.transpose() * Fa;
-    Kaa.topLeftCorner<3, 3>() = Pt;
-    Kaa.topRightCorner<3, 3>() = -DtStFa;
-    Kaa.bottomLeftCorner<3, 3>() = -DtStFa.transpose();
-    Kaa.bottomRightCorner<3, 3>() = Fa.transpose() * st.asDiagonal() * Fa + Pr;
-    if (sys_.contacts()[c].is_wall()) return;
-    const Mat3 Fb = lever(c, 1) * D;
-    const Mat3 DtStFb = StD.transpose() * Fb;
-    const Mat3 StFb = st.asDiagonal() * Fb;
-    Kbb.topLeftCorner<3, 3>() = Pt;
-    Kbb.topRightCorner<3, 3>() = -DtStFb;
-    Kbb.bottomLeftCorner<3, 3>() = -DtStFb.transpose();
-    Kbb.bottomRightCorner<3, 3>() = Fb.transpose() * StFb + Pr;
-    Kab.topLeftCorner<3, 3>() = -Pt;
-    Kab.topRightCorner<3, 3>() = DtStFb;
-    Kab.bottomLeftCorner<3, 3>() = DtStFa.transpose();
-    Kab.bottomRightCorner<3, 3>() = -(Fa.transpose() * StFb + Pr);
+    const bool wall = sys_.contacts()[c].is_wall();
+    skew_left(lever(c, 0), D, Fa);
+    if (!wall) skew_left(lever(c, 1), D, Fb);
+    // X^T S Y for 3x3 X, Y and diagonal S.
+    auto xsy = [](const M3 &X, const double *S, const M3 &Y, int i, int k) {
+      return X[0][i] * S[0] * Y[0][k] + X[1][i] * S[1] * Y[1][k] + X[2][i] * S[2] * Y[2][k];
+    };
+    for (int i = 0; i < 3; ++i)
+      for (int k = 0; k < 3; ++k) {
+        const double pt = xsy(D, st, D, i, k), pr = xsy(D, sr, D, i, k);
+        const double dfa = xsy(D, st, Fa, i, k), fad = xsy(Fa, st, D, i, k);
+        Kaa(i, k) = pt;
+        Kaa(i, k + 3) = -dfa;
+        Kaa(i + 3, k) = -fad;
+        Kaa(i + 3, k + 3) = xsy(Fa, st, Fa, i, k) + pr;
+        if (wall) continue;
+        const double dfb = xsy(D, st, Fb, i, k), fbd = xsy(Fb, st, D, i, k);
+        Kbb(i, k) = pt;
+        Kbb(i, k + 3) = -dfb;
+        Kbb(i + 3, k) = -fbd;
+        Kbb(i + 3, k + 3) = xsy(Fb, st, Fb, i, k) + pr;
+        Kab(i, k) = -pt;
+        Kab(i, k + 3) = dfb;
+        Kab(i + 3, k) = fad;
+        Kab(i + 3, k + 3) = -(xsy(Fa, st, Fb, i, k) + pr);
+      }
   }
 
  private:
   const ContactSystem &sys_;
   int rows_;
-  bool masked_;
+  bool plain_;  // six rows and no mask: the weights are all one
 };
 
 // ---- contact form ----
+//
+// Blocks are computed in contact order (streaming through the system's arrays) and stored at
+// their node, which is where the fibre relabelling takes effect.
 
 std::unique_ptr<Preconditioner> contact_jacobi(const ContactSystem &sys)
 {
@@ -413,8 +534,7 @@ std::unique_ptr<Preconditioner> contact_jacobi(const ContactSystem &sys)
   const int rows = sys.rows();
   Vector inv(sys.contact_dofs());
   for (int c = 0; c < sys.num_contacts(); ++c)
-    inv.segment(Eigen::Index(rows) * c, rows) =
-        blocks.contact_diag(c).diagonal().head(rows).cwiseInverse();
+    inv.segment(Eigen::Index(rows) * c, rows) = blocks.contact_diagonal(c).head(rows).cwiseInverse();
   return std::make_unique<DiagonalPreconditioner>(std::move(inv));
 }
 
@@ -425,14 +545,14 @@ std::unique_ptr<Preconditioner> contact_block(const ContactSystem &sys)
   ForestFactor f(nc, rows);
   for (int c = 0; c < nc; ++c) {
     f.set_node(c, rows * c, -1, 1);
-    f.diag(c) = blocks.contact_diag(c);
+    blocks.contact_diag(c, f.diag_data(c));
   }
   return finish("block", std::move(f), sys.contact_dofs(), true);
 }
 
 // Exact principal submatrix of A on every fibre (block tridiagonal: consecutive contacts
 // share one body, others none, and fibres share no body), diagonal blocks elsewhere. Nodes
-// follow the fibre numbering: the relabelling happens here, G is never permuted.
+// follow the fibre numbering: G is never permuted.
 std::unique_ptr<Preconditioner> contact_fibre(const ContactSystem &sys, const PrecondOptions &opt,
                                               FibreStats *stats)
 {
@@ -440,24 +560,22 @@ std::unique_ptr<Preconditioner> contact_fibre(const ContactSystem &sys, const Pr
   if (stats) *stats = fib.stats;
   const BlockBuilder blocks(sys);
   const int nc = sys.num_contacts(), rows = sys.rows();
-  ForestFactor f(nc, rows);
-  std::vector<char> in_fibre(nc, 0);
+  // node[c]: the fibre numbering; next[c]: the following contact of its fibre.
+  std::vector<int> node(nc, -1), next(nc, -1);
   int n = 0;
-  for (int k = 0; k < fib.num_fibres(); ++k) {
-    const int first = fib.contact_start[k], last = fib.contact_start[k + 1] - 1;
-    for (int i = first; i <= last; ++i, ++n) {
-      const int c = fib.contacts[i];
-      in_fibre[c] = 1;
-      f.set_node(n, rows * c, i < last ? n + 1 : -1, 1);
-      f.diag(n) = blocks.contact_diag(c);
-      if (i < last) f.coupling(n) = blocks.contact_coupling(c, fib.contacts[i + 1]);
+  for (int k = 0; k < fib.num_fibres(); ++k)
+    for (int i = fib.contact_start[k]; i < fib.contact_start[k + 1]; ++i) {
+      node[fib.contacts[i]] = n++;
+      if (i + 1 < fib.contact_start[k + 1]) next[fib.contacts[i]] = fib.contacts[i + 1];
     }
-  }
   for (int c = 0; c < nc; ++c)
-    if (!in_fibre[c]) {
-      f.set_node(n, rows * c, -1, 1);
-      f.diag(n++) = blocks.contact_diag(c);
-    }
+    if (node[c] < 0) node[c] = n++;
+  ForestFactor f(nc, rows);
+  for (int c = 0; c < nc; ++c) {
+    f.set_node(node[c], rows * c, next[c] >= 0 ? node[c] + 1 : -1, 1);
+    blocks.contact_diag(c, f.diag_data(node[c]));
+    if (next[c] >= 0) blocks.contact_coupling(c, next[c], f.coupling_data(node[c]));
+  }
   return finish("fibre", std::move(f), sys.contact_dofs(), true);
 }
 
@@ -489,51 +607,42 @@ std::unique_ptr<Preconditioner> contact_tree(const ContactSystem &sys, const Pre
     if (forest.parent[i] >= 0) has_child[forest.parent[i]] = 1;
 
   // Leaves first: a body's wall contacts, the body, then the contact to its parent body.
-  // Items: contact c -> c (>= 0), body i -> -1 - i.
-  std::vector<int> item, body_node(nb, -1);
-  std::vector<char> in_tree(nc, 0);
-  item.reserve(std::size_t(nc) + nb);
+  std::vector<int> body_node(nb, -1), contact_node(nc, -1);
+  int n = 0;
   for (int i : forest.order) {
     if (forest.parent[i] < 0 && !has_child[i] && wall_start[i] == wall_start[i + 1]) continue;
-    for (int w = wall_start[i]; w < wall_start[i + 1]; ++w) {
-      item.push_back(walls[w]);
-      in_tree[walls[w]] = 1;
-    }
-    body_node[i] = static_cast<int>(item.size());
-    item.push_back(-1 - i);
-    if (forest.parent_contact[i] >= 0) {
-      item.push_back(forest.parent_contact[i]);
-      in_tree[forest.parent_contact[i]] = 1;
-    }
+    for (int w = wall_start[i]; w < wall_start[i + 1]; ++w) contact_node[walls[w]] = n++;
+    body_node[i] = n++;
+    if (forest.parent_contact[i] >= 0) contact_node[forest.parent_contact[i]] = n++;
   }
+  const int tree_nodes = n;
   for (int c = 0; c < nc; ++c)
-    if (!in_tree[c]) item.push_back(c);
+    if (contact_node[c] < 0) contact_node[c] = n++;
 
-  ForestFactor f(static_cast<int>(item.size()), rows);
+  ForestFactor f(n, rows);
   const Vector &inv_mass = sys.inv_mass();
-  for (int n = 0; n < static_cast<int>(item.size()); ++n) {
-    if (item[n] < 0) {  // body i: -M_i, stored as M_i; coupled to its parent contact by -G^T
-      const int i = -1 - item[n];
-      const int pc = forest.parent_contact[i];
-      f.set_node(n, -1, pc >= 0 ? n + 1 : -1, -1);
-      f.diag(n) = inv_mass.segment<6>(6 * i).cwiseInverse().asDiagonal();
-      if (pc >= 0) f.coupling(n) = -blocks.jacobian(pc, contacts[pc].a == i ? 0 : 1).transpose();
-      continue;
-    }
-    const int c = item[n];
+  for (int i = 0; i < nb; ++i) {  // body i: -M_i, stored as M_i; -G^T to its parent contact
+    if (body_node[i] < 0) continue;
+    const int pc = forest.parent_contact[i];
+    f.set_node(body_node[i], -1, pc >= 0 ? body_node[i] + 1 : -1, -1);
+    f.set_diag(body_node[i], Vec6(inv_mass.segment<6>(6 * i).cwiseInverse()));
+    if (pc >= 0)
+      f.coupling(body_node[i]) = -blocks.jacobian(pc, contacts[pc].a == i ? 0 : 1).transpose();
+  }
+  for (int c = 0; c < nc; ++c) {
     const Contact &k = contacts[c];
-    if (!in_tree[c]) {
-      f.set_node(n, rows * c, -1, 1);
-      f.diag(n) = blocks.contact_diag(c);
+    if (contact_node[c] >= tree_nodes) {
+      f.set_node(contact_node[c], rows * c, -1, 1);
+      blocks.contact_diag(c, f.diag_data(contact_node[c]));
       continue;
     }
     // In the tree: Sigma_c (identity on padding rows), coupled to its parent body by -G_cj.
     const int j = k.is_wall() ? k.a : forest.parent[k.a] == k.b ? k.b : k.a;
-    f.set_node(n, rows * c, body_node[j], 1);
-    Mat6 d = Mat6::Identity();
-    for (int r = 0; r < rows; ++r) d(r, r) = sys.sigma()[Eigen::Index(rows) * c + r];
-    f.diag(n) = d;
-    f.coupling(n) = -blocks.jacobian(c, j == k.a ? 0 : 1);
+    f.set_node(contact_node[c], rows * c, body_node[j], 1);
+    Vec6 d = Vec6::Ones();
+    for (int r = 0; r < rows; ++r) d[r] = sys.sigma()[Eigen::Index(rows) * c + r];
+    f.set_diag(contact_node[c], d);
+    f.coupling(contact_node[c]) = -blocks.jacobian(c, j == k.a ? 0 : 1);
   }
   return finish("tree", std::move(f), sys.contact_dofs(), true);
 }
@@ -541,8 +650,12 @@ std::unique_ptr<Preconditioner> contact_tree(const ContactSystem &sys, const Pre
 // ---- body form ----
 
 // Diagonal blocks of K on owned bodies, complete over processes: ghost copies carry only
-// their local contacts' part (not M), which the exchange adds into the owners.
-std::vector<Mat6> owned_body_blocks(const ContactSystem &sys, const Exchange &ex)
+// their local contacts' part (not M), which the exchange adds into the owners. With `link`
+// (link[i]: the body that owned body i is coupled to in the preconditioner, or -1), also
+// K(i, link[i]) into f's coupling of node[i], summed over parallel contacts.
+std::vector<Mat6> body_blocks(const ContactSystem &sys, const Exchange &ex,
+                              const std::vector<int> *link = nullptr,
+                              const std::vector<int> *node = nullptr, ForestFactor *f = nullptr)
 {
   const int nb = sys.num_bodies(), owned = sys.num_owned_bodies();
   const BlockBuilder blocks(sys);
@@ -552,12 +665,19 @@ std::vector<Mat6> owned_body_blocks(const ContactSystem &sys, const Exchange &ex
     K[i].setZero();
     if (i < owned) K[i].diagonal() = inv_mass.segment<6>(6 * i).cwiseInverse();
   }
+  if (link)
+    for (int i = 0; i < owned; ++i)
+      if ((*link)[i] >= 0) f->coupling((*node)[i]).setZero();
   Mat6 Kaa, Kbb, Kab;
   for (int c = 0; c < sys.num_contacts(); ++c) {
     const Contact &k = sys.contacts()[c];
     blocks.body_parts(c, Kaa, Kbb, Kab);
     K[k.a] += Kaa;
-    if (!k.is_wall()) K[k.b] += Kbb;
+    if (k.is_wall()) continue;
+    K[k.b] += Kbb;
+    if (!link || k.a >= owned || k.b >= owned) continue;
+    if ((*link)[k.a] == k.b) f->coupling((*node)[k.a]) += Kab;
+    if ((*link)[k.b] == k.a) f->coupling((*node)[k.b]) += Kab.transpose();
   }
   Vector col(sys.body_dofs());
   for (int j = 0; j < kB; ++j) {
@@ -569,40 +689,35 @@ std::vector<Mat6> owned_body_blocks(const ContactSystem &sys, const Exchange &ex
   return K;
 }
 
-// K(i, j): the sum of J_ci^T Sigma_c^-1 J_cj over the contacts c between bodies i and j.
-Mat6 body_pair_block(const ContactSystem &sys, const BlockBuilder &blocks, const ContactGraph &g,
-                     int i, int j)
-{
-  Mat6 sum = Mat6::Zero(), Kaa, Kbb, Kab;
-  for (int e = g.start[i]; e < g.start[i + 1]; ++e)
-    if (g.neighbour[e] == j) {
-      const int c = g.contact[e];
-      blocks.body_parts(c, Kaa, Kbb, Kab);
-      if (sys.contacts()[c].a == i) sum += Kab;
-      else sum += Kab.transpose();
-    }
-  return sum;
-}
-
 std::unique_ptr<Preconditioner> body_jacobi(const ContactSystem &sys, const Exchange &ex)
 {
-  const std::vector<Mat6> K = owned_body_blocks(sys, ex);
+  const std::vector<Mat6> K = body_blocks(sys, ex);
   Vector inv = Vector::Zero(sys.body_dofs());
   for (int i = 0; i < sys.num_owned_bodies(); ++i)
     inv.segment<6>(6 * i) = K[i].diagonal().cwiseInverse();
   return std::make_unique<DiagonalPreconditioner>(std::move(inv));
 }
 
-std::unique_ptr<Preconditioner> body_block(const ContactSystem &sys, const Exchange &ex)
+// K's body blocks with K(i, link[i]) for a forest of links over owned bodies; node[i] lists
+// children before parents.
+std::unique_ptr<Preconditioner> body_forest(const char *name, const ContactSystem &sys,
+                                            const Exchange &ex, const std::vector<int> &link,
+                                            const std::vector<int> &node)
 {
-  const std::vector<Mat6> K = owned_body_blocks(sys, ex);
   const int owned = sys.num_owned_bodies();
   ForestFactor f(owned, kB);
-  for (int i = 0; i < owned; ++i) {
-    f.set_node(i, 6 * i, -1, 1);
-    f.diag(i) = K[i];
-  }
-  return finish("block", std::move(f), sys.body_dofs(), owned == sys.num_bodies());
+  for (int i = 0; i < owned; ++i)
+    f.set_node(node[i], 6 * i, link[i] >= 0 ? node[link[i]] : -1, 1);
+  const std::vector<Mat6> K = body_blocks(sys, ex, &link, &node, &f);
+  for (int i = 0; i < owned; ++i) f.set_diag(node[i], K[i]);
+  return finish(name, std::move(f), sys.body_dofs(), owned == sys.num_bodies());
+}
+
+std::unique_ptr<Preconditioner> body_block(const ContactSystem &sys, const Exchange &ex)
+{
+  std::vector<int> link(sys.num_owned_bodies(), -1), node(sys.num_owned_bodies());
+  for (int i = 0; i < sys.num_owned_bodies(); ++i) node[i] = i;
+  return body_forest("block", sys, ex, link, node);
 }
 
 // Block tridiagonal part of K along every fibre of owned bodies (chain neighbours coupled
@@ -612,29 +727,17 @@ std::unique_ptr<Preconditioner> body_fibre(const ContactSystem &sys, const Excha
 {
   const Fibres fib = build_fibres(sys, opt.weight, opt.impulses, false);
   if (stats) *stats = fib.stats;
-  const ContactGraph g = contact_graph(sys, false);
-  const BlockBuilder blocks(sys);
-  const std::vector<Mat6> K = owned_body_blocks(sys, ex);
   const int owned = sys.num_owned_bodies();
-  ForestFactor f(owned, kB);
-  std::vector<char> in_fibre(owned, 0);
+  std::vector<int> link(owned, -1), node(owned, -1);
   int n = 0;
-  for (int k = 0; k < fib.num_fibres(); ++k) {
-    const int first = fib.body_start[k], last = fib.body_start[k + 1] - 1;
-    for (int p = first; p <= last; ++p, ++n) {
-      const int i = fib.bodies[p];
-      in_fibre[i] = 1;
-      f.set_node(n, 6 * i, p < last ? n + 1 : -1, 1);
-      f.diag(n) = K[i];
-      if (p < last) f.coupling(n) = body_pair_block(sys, blocks, g, i, fib.bodies[p + 1]);
+  for (int k = 0; k < fib.num_fibres(); ++k)
+    for (int p = fib.body_start[k]; p < fib.body_start[k + 1]; ++p) {
+      node[fib.bodies[p]] = n++;
+      if (p + 1 < fib.body_start[k + 1]) link[fib.bodies[p]] = fib.bodies[p + 1];
     }
-  }
   for (int i = 0; i < owned; ++i)
-    if (!in_fibre[i]) {
-      f.set_node(n, 6 * i, -1, 1);
-      f.diag(n++) = K[i];
-    }
-  return finish("fibre", std::move(f), sys.body_dofs(), owned == sys.num_bodies());
+    if (node[i] < 0) node[i] = n++;
+  return body_forest("fibre", sys, ex, link, node);
 }
 
 // K on the forest's edges and all body blocks: tree-structured, Cholesky leaves first.
@@ -643,20 +746,10 @@ std::unique_ptr<Preconditioner> body_tree(const ContactSystem &sys, const Exchan
 {
   const Forest forest = build_forest(sys, opt.weight, opt.impulses, false);
   if (stats) *stats = forest.stats;
-  const ContactGraph g = contact_graph(sys, false);
-  const BlockBuilder blocks(sys);
-  const std::vector<Mat6> K = owned_body_blocks(sys, ex);
   const int owned = sys.num_owned_bodies();
-  std::vector<int> node(owned, -1);
+  std::vector<int> link(forest.parent.begin(), forest.parent.begin() + owned), node(owned, -1);
   for (int n = 0; n < owned; ++n) node[forest.order[n]] = n;
-  ForestFactor f(owned, kB);
-  for (int n = 0; n < owned; ++n) {
-    const int i = forest.order[n], p = forest.parent[i];
-    f.set_node(n, 6 * i, p >= 0 ? node[p] : -1, 1);
-    f.diag(n) = K[i];
-    if (p >= 0) f.coupling(n) = body_pair_block(sys, blocks, g, i, p);
-  }
-  return finish("tree", std::move(f), sys.body_dofs(), owned == sys.num_bodies());
+  return body_forest("tree", sys, ex, link, node);
 }
 
 }  // namespace

@@ -195,8 +195,8 @@ TEST(Report, ConvergenceToVelocityError)
               kBodies, pile.num_contacts(), walls, 2.0 * body_contacts / kBodies,
               long(pile.contact_dofs()), long(pile.body_dofs()), mean_diag);
   std::printf("Iterations to ||dv - dv*|| / ||dv*|| <= %.0e (cap %d; '>%d (e)' = best error "
-              "reached, '!' = the error exceeded 1 on the way; a stop reason other than max_iterations "
-              "is named).\n",
+              "reached, '!' = the error exceeded 1 on the way; a stop reason other than "
+              "max_iterations is named).\n",
               kTarget, kMaxIter, kMaxIter);
 
   const struct {

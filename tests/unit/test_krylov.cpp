@@ -121,13 +121,14 @@ TEST(Krylov, AllCombinationsReachDirectVelocities)
         for (Method m : kMethods) {
           SCOPED_TRACE(std::string(which ? "pile " : "grid ") + to_string(form) + " " +
                        to_string(kind) + " " + to_string(m));
+          // Near each form's attainable accuracy (contact ~1e-13, body ~1e-15 here).
           StopControl stop;
-          stop.tol = 1e-12;
+          stop.tol = form == Form::contact ? 1e-11 : 1e-13;
           stop.max_iter = 5000;
           Vector x = Vector::Zero(A->size());
           const SolveResult res = krylov_solve(m, *A, *P, b, x, stop);
           EXPECT_EQ(res.reason, StopReason::converged);
-          EXPECT_LE(res.rel_residual, 1e-12);
+          EXPECT_LE(res.rel_residual, stop.tol);
           Vector lambda = x;
           if (form == Form::body) {
             lambda = lambda_from_body(sys, serial_exchange(), ref.b, x);
@@ -167,7 +168,8 @@ TEST(Krylov, CrAndMinresResidualsAreMonotone)
   const ContactSystem sys = scene(1);
   for (Form form : kForms) {
     const auto A = make_operator(form, sys, serial_exchange());
-    const Vector b = form == Form::contact ? sys.rhs() : body_rhs(sys, serial_exchange(), sys.rhs());
+    const Vector b =
+        form == Form::contact ? sys.rhs() : body_rhs(sys, serial_exchange(), sys.rhs());
     for (PrecondKind kind : kPreconds) {
       PrecondOptions popt;
       popt.kind = kind;

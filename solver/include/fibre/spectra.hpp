@@ -14,9 +14,11 @@
 //   and the preconditioner to unit vectors, through the symmetric generalized problem. One
 //   process, O(n^3): small systems and cross-checks.
 // - lanczos_spectrum: preconditioned Lanczos with full reorthogonalization, using only
-//   applies and the operator's (global) inner product, so it scales and runs under MPI. Its
-//   gap search runs over the converged Ritz values only, so that the sparse, unconverged
-//   Ritz values inside a wide cluster cannot pose as gaps.
+//   applies and the operator's (global) inner product, so it scales and runs under MPI.
+//   Sparse, unconverged Ritz values can pose as gaps: r then points at an unconverged value
+//   and the iteration goes on. It is quick where the spectrum has a clear gap and moderate
+//   kappa_e; without a gap kappa_e hinges on the finest detail at the bottom of the spectrum
+//   and Lanczos needs about n steps (then the dense path is as fast).
 // - body_space_spectrum: the contact-space A without preconditioner when Sigma = sigma I:
 //   the nonzero spectrum of G M^-1 G^T is that of M^-1/2 G^T G M^-1/2 (6 per body instead
 //   of rows() per contact), and A adds sigma to it; the rest of A's spectrum is sigma.
@@ -41,10 +43,10 @@ struct Spectrum {
   double kappa = 1;       // lambda_max / lambda_min
   double kappa_e = 1;     // lambda_max / lambda_r
   int iterations = 0;     // Lanczos steps (0 for the dense paths)
-  // Lanczos: converged = lambda_1, lambda_r, the value below lambda_r and the smallest Ritz
-  // value met their tolerances and kappa_e repeated over two checks; certified = besides,
-  // every stretch of the spectrum that could hide a larger gap is resolved (or an invariant
-  // subspace was found). Dense paths: both true.
+  // Lanczos: converged = lambda_1 and lambda_r met the tolerance and kappa_e and the gap
+  // repeated over two checks; certified = besides, the Ritz values at the gap and at the
+  // bottom settled and no unresolved stretch of the spectrum can hide a larger gap (or an
+  // invariant subspace was found). Dense paths: both true.
   bool converged = true;
   bool certified = true;
 };

@@ -1,0 +1,338 @@
+// System files: exact round trips, one specific error per kind of damage, and Matrix Market
+// export read back by an independent little parser and compared with the dense reference.
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <cstdio>
+#include <fstream>
+#include <limits>
+#include <sstream>
+
+#include "fibre/scenes.hpp"
+#include "fibre/system_io.hpp"
+#include "reference.hpp"
+
+using namespace fibre;
+
+namespace {
+
+// A pile with ghosts, a row mask, awkward numbers and a rhs that is not spook_rhs.
+ContactSystem sample_system(int rows = 6)
+{
+  SceneParams p;
+  p.rows = rows;
+  p.spook.h = 1.0 / 3.0e3;
+  p.spook.damping = 2.5;
+  const ContactSystem pile = pile_scene(25, p);
+  std::vector<Body> bodies = pile.bodies();
+  bodies[0].v = Vec3(-0.0, 1e-310, 0.1);  // signed zero and a subnormal
+  bodies[1].torque = Vec3(1e300, -1.0 / 7.0, 3.0);
+  std::vector<Contact> contacts = pile.contacts();
+  contacts[0].compliance = {1e-8, 2e-8, 3e-8, 4e-8, 5e-8, 6e-8};
+  ContactSystem sys(bodies, contacts, rows, p.spook, pile.num_bodies() - 4);
+  std::vector<unsigned char> mask(sys.contact_dofs(), 1);
+  for (std::size_t r = 2; r < mask.size(); r += 7) mask[r] = 0;
+  sys.set_row_mask(mask);
+  Vector rhs = spook_rhs(sys);
+  rhs[1] = std::sqrt(2.0);
+  sys.set_rhs(rhs);
+  return sys;
+}
+
+std::string to_text(const ContactSystem &sys)
+{
+  std::ostringstream out;
+  write_system(out, sys);
+  return out.str();
+}
+
+void expect_identical(const ContactSystem &a, const ContactSystem &b)
+{
+  ASSERT_EQ(a.rows(), b.rows());
+  ASSERT_EQ(a.num_bodies(), b.num_bodies());
+  ASSERT_EQ(a.num_contacts(), b.num_contacts());
+  EXPECT_EQ(a.num_owned_bodies(), b.num_owned_bodies());
+  EXPECT_EQ(a.params().h, b.params().h);
+  EXPECT_EQ(a.params().damping, b.params().damping);
+  // Bitwise: memcmp-like equality, so that -0.0 and 0.0 differ.
+  auto same = [](double x, double y) { return std::signbit(x) == std::signbit(y) && x == y; };
+  auto same3 = [&](const Vec3 &x, const Vec3 &y) {
+    return same(x[0], y[0]) && same(x[1], y[1]) && same(x[2], y[2]);
+  };
+  for (int i = 0; i < a.num_bodies(); ++i) {
+    const Body &p = a.bodies()[i], &q = b.bodies()[i];
+    EXPECT_TRUE(same(p.mass, q.mass) && same(p.radius, q.radius) && same3(p.x, q.x) &&
+                same3(p.v, q.v) && same3(p.omega, q.omega) && same3(p.force, q.force) &&
+                same3(p.torque, q.torque))
+        << "body " << i;
+  }
+  for (int c = 0; c < a.num_contacts(); ++c) {
+    const Contact &p = a.contacts()[c], &q = b.contacts()[c];
+    EXPECT_TRUE(p.a == q.a && p.b == q.b && same3(p.normal, q.normal) && same3(p.t1, q.t1) &&
+                same3(p.t2, q.t2) && same3(p.point, q.point) && same(p.gap, q.gap) &&
+                p.compliance == q.compliance)
+        << "contact " << c;
+  }
+  EXPECT_EQ(a.row_mask(), b.row_mask());
+  ASSERT_EQ(a.rhs().size(), b.rhs().size());
+  for (Eigen::Index i = 0; i < a.rhs().size(); ++i) EXPECT_TRUE(same(a.rhs()[i], b.rhs()[i]));
+  EXPECT_EQ(a.sigma(), b.sigma());
+  EXPECT_EQ(a.inv_mass(), b.inv_mass());
+}
+
+std::vector<std::string> lines_of(const std::string &text)
+{
+  std::vector<std::string> lines;
+  std::istringstream in(text);
+  for (std::string l; std::getline(in, l);) lines.push_back(l);
+  return lines;
+}
+
+std::string join(const std::vector<std::string> &lines)
+{
+  std::string s;
+  for (const std::string &l : lines) s += l + "\n";
+  return s;
+}
+
+// Index of the first line that starts with `prefix`.
+std::size_t find_line(const std::vector<std::string> &lines, const std::string &prefix)
+{
+  for (std::size_t i = 0; i < lines.size(); ++i)
+    if (lines[i].rfind(prefix, 0) == 0) return i;
+  ADD_FAILURE() << "no line starts with " << prefix;
+  return 0;
+}
+
+// Replaces token k of a line.
+std::string with_token(const std::string &line, std::size_t k, const std::string &value)
+{
+  std::istringstream in(line);
+  std::vector<std::string> t;
+  for (std::string w; in >> w;) t.push_back(w);
+  t.at(k) = value;
+  std::string s;
+  for (std::size_t i = 0; i < t.size(); ++i) s += (i ? " " : "") + t[i];
+  return s;
+}
+
+// parse_system must throw std::runtime_error whose message contains every `parts` string.
+void expect_error(const std::string &text, std::initializer_list<std::string> parts)
+{
+  try {
+    parse_system(text);
+    ADD_FAILURE() << "accepted a malformed system; expected: " << *parts.begin();
+  } catch (const std::runtime_error &e) {
+    for (const std::string &p : parts)
+      EXPECT_NE(std::string(e.what()).find(p), std::string::npos)
+          << "message '" << e.what() << "' lacks '" << p << "'";
+  }
+}
+
+std::string temp_path(const std::string &name)
+{
+  return "/tmp/fibre_io_" + std::to_string(getpid()) + "_" + name;
+}
+
+}  // namespace
+
+TEST(SystemIo, RoundTripIsExact)
+{
+  for (int rows : {6, 3}) {
+    const ContactSystem sys = sample_system(rows);
+    const std::string text = to_text(sys);
+    EXPECT_EQ(text.rfind("fibre_contact_system 1\n", 0), 0u);
+    const ContactSystem back = parse_system(text);
+    expect_identical(sys, back);
+    EXPECT_EQ(to_text(back), text);  // and the writer is deterministic
+  }
+}
+
+TEST(SystemIo, FileRoundTripAndMissingFile)
+{
+  const ContactSystem sys = sample_system();
+  const std::string path = temp_path("sys.txt");
+  write_system_file(path, sys);
+  expect_identical(sys, read_system_file(path));
+  std::remove(path.c_str());
+  try {
+    read_system_file(path);
+    ADD_FAILURE() << "read a missing file";
+  } catch (const std::runtime_error &e) {
+    EXPECT_NE(std::string(e.what()).find("cannot open"), std::string::npos) << e.what();
+  }
+  EXPECT_THROW(write_system_file("/nonexistent_dir/x.txt", sys), std::runtime_error);
+}
+
+TEST(SystemIo, EmptySystemAndCommentsRoundTrip)
+{
+  const ContactSystem empty({}, {}, 6, SpookParams{});
+  expect_identical(empty, parse_system(to_text(empty)));
+  // Comments and blank lines anywhere, CRLF line ends.
+  std::string text = to_text(sample_system());
+  std::string crlf;
+  for (char c : text) crlf += c == '\n' ? std::string("\r\n\n# note\n") : std::string(1, c);
+  expect_identical(sample_system(), parse_system(crlf));
+}
+
+TEST(SystemIo, EachMalformedInputGetsItsOwnError)
+{
+  const ContactSystem sys = sample_system();
+  const std::string text = to_text(sys);
+  const std::vector<std::string> L = lines_of(text);
+  const std::size_t bodies = find_line(L, "bodies "), contacts = find_line(L, "contacts ");
+  const std::size_t mask = find_line(L, "mask "), rhs = find_line(L, "rhs ");
+  auto edit = [&](std::size_t line, const std::string &content) {
+    std::vector<std::string> v = L;
+    v[line] = content;
+    return join(v);
+  };
+  auto line_tag = [](std::size_t index) { return "line " + std::to_string(index + 1) + ":"; };
+
+  expect_error("", {"line 1:", "unexpected end of input", "header"});
+  expect_error(edit(0, "fibre_contact_sistem 1"), {"line 1:", "not a fibre_contact system"});
+  expect_error(edit(0, "fibre_contact_system 2"), {"unsupported format version 2"});
+  expect_error(edit(0, "fibre_contact_system one"), {"'one' is not an integer"});
+  expect_error(edit(2, "rows 4"), {"rows must be 3 or 6"});
+  expect_error(edit(3, "spook 0 2"), {"time step h must be positive"});
+  expect_error(edit(3, "spook"), {"expected 'spook <h> <damping>'"});
+
+  // Truncation: between lines, in the middle of one, and early (a count then claims more
+  // than the rest of the input holds).
+  {
+    const long n = static_cast<long>(sys.contact_dofs());
+    std::vector<std::string> v(L.begin(), L.begin() + rhs + 1 + n / 2);
+    expect_error(join(v), {"unexpected end of input, expected rhs entry " +
+                               std::to_string(n / 2) + " of " + std::to_string(n)});
+    const std::size_t last = mask - 1;  // the last contact line
+    const std::string cut = join(std::vector<std::string>(L.begin(), L.begin() + last)) +
+        L[last].substr(0, L[last].size() / 2);
+    expect_error(cut, {line_tag(last), "contact " + std::to_string(sys.num_contacts() - 1) +
+                                           ": expected 21 values"});
+    expect_error(text.substr(0, text.size() - 4), {"unexpected end of input", "'end'"});
+    std::vector<std::string> early(L.begin(), L.begin() + bodies + 3);
+    expect_error(join(early), {line_tag(bodies), "body count 25 is more than the rest"});
+  }
+
+  // Counts: mismatched and absurd.
+  expect_error(edit(bodies, "bodies " + std::to_string(sys.num_bodies() + 1) + " 0"),
+               {"body " + std::to_string(sys.num_bodies()) + ": expected 17 values"});
+  expect_error(edit(bodies, "bodies 3 0"), {"expected 'contacts <count>'"});
+  expect_error(edit(bodies, "bodies 4000000000 0"),
+               {line_tag(bodies), "body count 4000000000 is more than the rest of the input"});
+  expect_error(edit(bodies, "bodies 100000 0"), {"more than the rest of the input can hold"});
+  expect_error(edit(bodies, "bodies -1 0"), {"body count -1 is negative"});
+  expect_error(edit(bodies, "bodies 25 26"), {"owned body count 26 is not in [0, 25]"});
+  expect_error(edit(contacts, "contacts 99999999999999999999"), {"is not an integer"});
+  expect_error(edit(mask, "mask 5"), {"mask count 5 is neither 0 nor rows * contacts"});
+  expect_error(edit(rhs, "rhs 3"), {"rhs count 3 differs from rows * contacts"});
+  expect_error(edit(mask + 1, "2"), {"mask entry must be 0 or 1"});
+
+  // Values: non-numeric, non-finite, out of range, physically invalid.
+  expect_error(edit(bodies + 1, with_token(L[bodies + 1], 0, "abc")),
+               {line_tag(bodies + 1), "'abc' is not a number (body 0 mass)"});
+  expect_error(edit(bodies + 2, with_token(L[bodies + 2], 3, "nan")),
+               {"non-finite value 'nan' (body 1 position)"});
+  expect_error(edit(bodies + 2, with_token(L[bodies + 2], 6, "-inf")), {"non-finite value"});
+  expect_error(edit(bodies + 2, with_token(L[bodies + 2], 6, "1e999")), {"out of range"});
+  expect_error(edit(bodies + 1, with_token(L[bodies + 1], 0, "-1")),
+               {"body 0: mass must be positive"});
+  expect_error(edit(rhs + 1, "0x1p3"), {"'0x1p3' is not a number (rhs entry 0)"});
+  expect_error(edit(rhs + 1, "1.0 2.0"), {"rhs entry 0: expected 1 values, found 2"});
+
+  // Contacts: body indices, frames, compliance.
+  const std::string c0 = L[contacts + 1];
+  expect_error(edit(contacts + 1, with_token(c0, 0, "25")),
+               {"contact 0: body index 25 out of range [0, 25)"});
+  expect_error(edit(contacts + 1, with_token(c0, 1, "-2")),
+               {"contact 0: body index -2 out of range [-1, 25)"});
+  expect_error(edit(contacts + 1, with_token(with_token(c0, 0, "3"), 1, "3")),
+               {"contact 0: a body in contact with itself"});
+  expect_error(edit(contacts + 1, with_token(c0, 2, "2")), {"contact 0 normal is not a unit"});
+  expect_error(edit(contacts + 1, with_token(c0, 15, "0")),
+               {"contact 0: compliance of row 0 must be positive"});
+  expect_error(edit(contacts + 1, c0 + " 7"), {"contact 0: expected 21 values, found 22"});
+
+  // Anything after the end, and binary junk.
+  expect_error(text + "bodies 1 1\n", {"unexpected content after 'end'"});
+  expect_error(std::string("\x7f\x45\x4c\x46\x02\x01\x01\0\0", 9), {"not a fibre_contact system"});
+}
+
+TEST(SystemIo, FrameMustBeOrthonormal)
+{
+  const std::string text = to_text(sample_system());
+  std::vector<std::string> L = lines_of(text);
+  const std::size_t c = find_line(L, "contacts ") + 1;
+  // t1 := n: unit, but not orthogonal to n.
+  std::istringstream in(L[c]);
+  std::vector<std::string> t;
+  for (std::string w; in >> w;) t.push_back(w);
+  for (int k = 0; k < 3; ++k) L[c] = with_token(L[c], 5 + k, t[2 + k]);
+  expect_error(join(L), {"contact 0: normal, t1 and t2 are not orthogonal"});
+}
+
+// ---- Matrix Market ----
+
+namespace {
+
+struct Market {
+  std::string header;
+  Eigen::MatrixXd M;
+};
+
+// An independent reader for the two Matrix Market kinds written (coordinate, array).
+Market read_market(const std::string &path)
+{
+  std::ifstream in(path);
+  Market m;
+  std::getline(in, m.header);
+  std::string line;
+  while (std::getline(in, line) && line[0] == '%') {
+  }
+  std::istringstream size(line);
+  long rows = 0, cols = 0, nnz = 0;
+  size >> rows >> cols;
+  m.M = Eigen::MatrixXd::Zero(rows, cols);
+  if (m.header.find("array") != std::string::npos) {
+    for (long j = 0; j < cols; ++j)
+      for (long i = 0; i < rows; ++i) in >> m.M(i, j);
+    return m;
+  }
+  size >> nnz;
+  const bool symmetric = m.header.find("symmetric") != std::string::npos;
+  for (long e = 0; e < nnz; ++e) {
+    long i, j;
+    double v;
+    in >> i >> j >> v;
+    EXPECT_TRUE(!symmetric || i >= j) << "symmetric files hold the lower triangle";
+    m.M(i - 1, j - 1) = v;
+    if (symmetric) m.M(j - 1, i - 1) = v;
+  }
+  EXPECT_TRUE(static_cast<bool>(in)) << path << " is short";
+  return m;
+}
+
+}  // namespace
+
+TEST(SystemIo, MatrixMarketExportMatchesDenseReference)
+{
+  const ContactSystem sys = sample_system();
+  const std::string prefix = temp_path("mm");
+  export_matrix_market(sys, prefix);
+  const Market G = read_market(prefix + "_G.mtx"), Minv = read_market(prefix + "_Minv.mtx");
+  const Market S = read_market(prefix + "_Sigma.mtx"), A = read_market(prefix + "_A.mtx");
+  const Market b = read_market(prefix + "_b.mtx");
+  EXPECT_EQ(G.header, "%%MatrixMarket matrix coordinate real general");
+  EXPECT_EQ(A.header, "%%MatrixMarket matrix coordinate real symmetric");
+  EXPECT_EQ(b.header, "%%MatrixMarket matrix array real general");
+  EXPECT_EQ(G.M, test::dense_G(sys));
+  EXPECT_EQ(Minv.M, test::dense_Minv(sys));
+  EXPECT_EQ(Eigen::VectorXd(S.M.diagonal()), test::dense_sigma(sys));
+  const test::Dense Aref = test::dense_A(sys);
+  EXPECT_LT((A.M - Aref).norm(), 1e-13 * Aref.norm());
+  ASSERT_EQ(b.M.cols(), 1);
+  EXPECT_EQ(Eigen::VectorXd(b.M.col(0)), sys.rhs());
+  for (const char *f : {"_G", "_Minv", "_Sigma", "_A", "_b"})
+    std::remove((prefix + f + ".mtx").c_str());
+  EXPECT_THROW(export_matrix_market(sys, "/nonexistent_dir/x"), std::runtime_error);
+}
