@@ -23,6 +23,7 @@
 #include "comm.h"
 #include "domain.h"
 #include "error.h"
+#include "fibre/system_io.hpp"
 #include "fix_fibre_exchange.h"
 #include "force.h"
 #include "group.h"
@@ -35,12 +36,6 @@
 #include "update.h"
 #include "utils.h"
 
-#if __has_include("fibre/system_io.hpp")
-#include "fibre/system_io.hpp"
-#define FIBRE_HAVE_SYSTEM_IO 1
-#else
-#define FIBRE_HAVE_SYSTEM_IO 0
-#endif
 
 using namespace LAMMPS_NS;
 using namespace FixConst;
@@ -52,6 +47,13 @@ constexpr int kWallKeyStride = 1024;  // wall key = wall index * stride + sub-wa
 constexpr double kRestartFormat = 1.0;
 // pairs closer than this fraction of the smaller radius are always contacts
 constexpr double kContactMargin = 0.01;
+// The warm start of the friction, rolling and twisting rows is scaled by this factor so that
+// it lies strictly inside its cone. Workaround: fibre::solve_step pre-caps cones whose warm
+// impulse is on the boundary and its active-set test for capped rows (trial impulse
+// lambda + rho / sigma) then never un-caps them, so a sliding contact never sticks again (a
+// sliding sphere accelerates backwards through v = 0). Starting inside the cone, the first
+// pass solves the cone as sticking and caps it only if the solve leaves the cone.
+constexpr double kWarmConeShrink = 1.0 - 1e-6;
 
 bool to_double(const char *s, double &value)
 {
@@ -695,8 +697,13 @@ void FixFibreContact::warm_start(const std::vector<Found> &found, int rows,
     const fibre::Vec3 force(slot[1], slot[2], slot[3]), moment(slot[4], slot[5], slot[6]);
     const fibre::Contact &k = fc.contact;
     const fibre::Vec3 dirs[3] = {k.normal, k.t1, k.t2};
-    for (int r = 0; r < rows; ++r)
-      warm[Eigen::Index(rows) * c + r] = dtv_ * (r < 3 ? force.dot(dirs[r]) : moment.dot(dirs[r - 3]));
+    for (int r = 0; r < rows; ++r) {
+      // Friction, rolling and twisting rows start strictly inside their cone (see
+      // kWarmConeShrink); the normal row keeps last step's value.
+      const double shrink = r == 0 ? 1.0 : kWarmConeShrink;
+      warm[Eigen::Index(rows) * c + r] =
+          shrink * dtv_ * (r < 3 ? force.dot(dirs[r]) : moment.dot(dirs[r - 3]));
+    }
   }
 }
 
@@ -788,24 +795,35 @@ void FixFibreContact::fill_local_output(const std::vector<Found> &found,
 
 /* ---------------------------------------------------------------------- */
 
-void FixFibreContact::export_system(const fibre::ContactSystem &sys, const fibre::Vector *lambda)
+void FixFibreContact::export_system(const fibre::ContactSystem &sys, const std::vector<Found> &found,
+                                    const fibre::Vector *lambda)
 {
-#if FIBRE_HAVE_SYSTEM_IO
-  const std::string path = export_prefix_ + "." +
+  const std::string base = export_prefix_ + "." +
                            std::to_string(static_cast<long long>(update->ntimestep)) + "." +
-                           std::to_string(comm->me) + ".sys";
+                           std::to_string(comm->me);
   try {
-    fibre::write_system(path, sys, lambda);
+    fibre::write_system_file(base + ".sys", sys);
   } catch (std::exception &e) {
-    error->one(FLERR, "Fix fibre_contact could not write export file " + path + ": " + e.what());
+    error->one(FLERR, "Fix fibre_contact could not write export file " + base + ".sys: " +
+                          e.what());
   }
-#else
-  (void) sys;
-  (void) lambda;
-  if (comm->me == 0 && update->ntimestep == update->firststep + export_every_)
-    error->warning(FLERR, std::string("Fix fibre_contact: export is not available in this "
-                                      "build (no system_io in the solver library)"));
-#endif
+  // the solution, with the atoms of every contact
+  FILE *fp = std::fopen((base + ".lambda").c_str(), "w");
+  if (!fp) error->one(FLERR, "Fix fibre_contact could not write export file " + base + ".lambda");
+  const int rows = sys.rows();
+  std::fprintf(fp, "# fibre_contact impulses, step %lld, process %d: %d contacts, %d rows each\n",
+               static_cast<long long>(update->ntimestep), comm->me, sys.num_contacts(), rows);
+  std::fprintf(fp, "# contact tag_a tag_b(0 = wall) wall(0 = none) lambda_0 .. lambda_%d\n",
+               rows - 1);
+  for (int c = 0; c < sys.num_contacts(); ++c) {
+    const Found &fc = found[c];
+    std::fprintf(fp, "%d %lld %lld %d", c, static_cast<long long>(fc.tag_a),
+                 static_cast<long long>(fc.partner > 0 ? fc.partner : 0.0), fc.wall + 1);
+    for (int r = 0; r < rows; ++r)
+      std::fprintf(fp, " %.17g", lambda ? (*lambda)[Eigen::Index(rows) * c + r] : 0.0);
+    std::fprintf(fp, "\n");
+  }
+  std::fclose(fp);
 }
 
 /* ---------------------------------------------------------------------- */
@@ -902,7 +920,7 @@ void FixFibreContact::final_integrate()
     if (do_export) {
       fibre::ContactSystem empty(bodies, {}, rows_, fibre::SpookParams{dtv_, damping_},
                                  exchange_->num_owned());
-      export_system(empty, nullptr);
+      export_system(empty, found, nullptr);
     }
     check_finite("velocity", atom->v, 3);
     return;
@@ -951,7 +969,7 @@ void FixFibreContact::final_integrate()
   store_impulses(found, *sys, res.lambda);
   fill_local_output(found, &res.lambda);
   report_solve(res);
-  if (do_export) export_system(*sys, &res.lambda);
+  if (do_export) export_system(*sys, found, &res.lambda);
 
   if (overflow_count_ > 0 && !overflow_warned_ && comm->me == 0) {
     error->warning(FLERR, "Fix fibre_contact: more than " + std::to_string(kMaxSlots) +

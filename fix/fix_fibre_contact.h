@@ -97,7 +97,8 @@ class FixFibreContact : public Fix {
   void update_velocities(const fibre::Vector *dv);
   void check_finite(const char *what, double **array, int nvalues) const;
   void fill_local_output(const std::vector<Found> &found, const fibre::Vector *lambda);
-  void export_system(const fibre::ContactSystem &sys, const fibre::Vector *lambda);
+  void export_system(const fibre::ContactSystem &sys, const std::vector<Found> &found,
+                     const fibre::Vector *lambda);
   void report_solve(const fibre::StepResult &res);
 
   // settings

@@ -112,11 +112,10 @@ inline void unit_upper_solve6(const double *l, double *x)
 // tree: there every pivot keeps its sign, so no pivoting is needed.
 class ForestFactor {
  public:
-  // The coupling storage is reserved for every node but only touched for nodes with a
-  // parent (the pages of the others are never written).
+  // Two phases: set_node() for every node, then link(), then the values.
   ForestFactor(int nodes, int dim)
-      : dim_(dim), parent_(nodes, -1), offset_(nodes, -1), sign_(nodes, 1),
-        l_(new double[std::size_t(kPacked) * nodes]), w_(new double[std::size_t(kBlock) * nodes])
+      : dim_(dim), parent_(nodes, -1), offset_(nodes, -1), wslot_(nodes, -1), sign_(nodes, 1),
+        l_(new double[std::size_t(kPacked) * nodes])
   {
   }
   int nodes() const { return static_cast<int>(parent_.size()); }
@@ -137,6 +136,15 @@ class ForestFactor {
       FIBRE_UNROLL
       for (int i = j; i < kB; ++i) l[at(i, j)] = d(i, j);
   }
+  // Coupling storage for the nodes with a parent only, in node order (the factorization
+  // streams through it): setup cost is mostly first touch of fresh memory.
+  void link()
+  {
+    int slots = 0;
+    for (int n = 0; n < nodes(); ++n)
+      if (parent_[n] >= 0) wslot_[n] = slots++;
+    w_.reset(new double[std::size_t(kBlock) * slots]);
+  }
   // Packed lower triangle of sign_n D_n, to be filled in place.
   double *diag_data(int n) { return l_.get() + std::size_t(kPacked) * n; }
   void set_diag(int n, const Vec6 &diagonal)
@@ -146,11 +154,11 @@ class ForestFactor {
     for (int i = 0; i < kB; ++i) l[at(i, i)] = diagonal[i];
   }
   // Row-major B_n, to be filled in place.
-  double *coupling_data(int n) { return w_.get() + std::size_t(kBlock) * n; }
+  double *coupling_data(int n) { return w_.get() + std::size_t(kBlock) * wslot_[n]; }
   // B_n = A(n, parent), for a node with a parent.
   Eigen::Map<RowMat6> coupling(int n)
   {
-    return Eigen::Map<RowMat6>(w_.get() + std::size_t(kBlock) * n);
+    return Eigen::Map<RowMat6>(coupling_data(n));
   }
 
   void factor()
@@ -160,7 +168,7 @@ class ForestFactor {
       ldlt6(l);
       const int p = parent_[n];
       if (p < 0) continue;
-      double *v = w_.get() + std::size_t(kBlock) * n;
+      double *v = w_.get() + std::size_t(kBlock) * wslot_[n];
       // V = L^-1 B on whole rows.
       FIBRE_UNROLL
       for (int i = 1; i < kB; ++i)
@@ -213,7 +221,7 @@ class ForestFactor {
       for (int i = 0; i < kB; ++i) un[i] *= l[at(i, i)];
       const int p = parent_[n];
       if (p < 0) continue;
-      const double *v = w_.get() + std::size_t(kBlock) * n;
+      const double *v = w_.get() + std::size_t(kBlock) * wslot_[n];
       double *up = u + kB * p;
       const double s = sign_[n];
       FIBRE_UNROLL
@@ -230,7 +238,7 @@ class ForestFactor {
       const double *l = l_.get() + std::size_t(kPacked) * n;
       const int p = parent_[n];
       if (p >= 0) {
-        const double *v = w_.get() + std::size_t(kBlock) * n;
+        const double *v = w_.get() + std::size_t(kBlock) * wslot_[n];
         const double *xp = u + kB * p;
         FIBRE_UNROLL
         for (int k = 0; k < kB; ++k) {
@@ -252,9 +260,10 @@ class ForestFactor {
   int dim_;
   std::vector<int> parent_;
   std::vector<int> offset_;
+  std::vector<int> wslot_;  // position in w_, -1 for roots
   std::vector<signed char> sign_;
   std::unique_ptr<double[]> l_;  // 21 per node: sign D, then its L Delta L^T factor
-  std::unique_ptr<double[]> w_;  // 36 per node, used by nodes with a parent
+  std::unique_ptr<double[]> w_;  // 36 per node with a parent: B, then V = L^-1 B
 };
 
 class ForestPreconditioner final : public Preconditioner {
@@ -338,6 +347,8 @@ inline void skew_right(const M3 &m, const Skew &q, M3 &x)
 
 class BlockBuilder {
  public:
+  static constexpr int kPrefetch = 8;
+
   explicit BlockBuilder(const ContactSystem &sys)
       : sys_(sys), rows_(sys.rows()), plain_(sys.row_mask().empty() && sys.rows() == kB)
   {
@@ -359,6 +370,26 @@ class BlockBuilder {
   int body(int c, int side) const
   {
     return side == 0 ? sys_.contacts()[c].a : sys_.contacts()[c].b;
+  }
+  // Contact loops run in contact order, but bodies are scattered: ask for the inverse masses
+  // of the contact kPrefetch ahead (c may be past the end) and, if given, of another contact.
+  void prefetch(int c, int other = -1) const
+  {
+#if defined(__GNUC__)
+    const int ahead = c + kPrefetch;
+    if (ahead < sys_.num_contacts()) {
+      const Contact &k = sys_.contacts()[ahead];
+      __builtin_prefetch(sys_.inv_mass().data() + 6 * k.a);
+      if (k.b >= 0) __builtin_prefetch(sys_.inv_mass().data() + 6 * k.b);
+    }
+    if (other >= 0) {
+      __builtin_prefetch(&sys_.contacts()[other]);
+      __builtin_prefetch(&sys_.kinematics(other));
+    }
+#else
+    (void)c;
+    (void)other;
+#endif
   }
   double mu(int j) const { return sys_.inv_mass()[6 * j]; }
   double iota(int j) const { return sys_.inv_mass()[6 * j + 3]; }
@@ -474,50 +505,74 @@ class BlockBuilder {
     return J;
   }
 
-  // Body-space parts of one contact: J_a^T Sigma^-1 J_a, J_b^T Sigma^-1 J_b and
-  // K_ab = J_a^T Sigma^-1 J_b. With F = Q D and S_t, S_r the translational and rotational
-  // rows of Sigma^-1 (0 where masked or absent),
-  //   J^T Sigma^-1 J' = s s' [D^T S_t D, -D^T S_t F'; -F^T S_t D, F^T S_t F' + D^T S_r D].
-  void body_parts(int c, Mat6 &Kaa, Mat6 &Kbb, Mat6 &Kab) const
+  // Body-space parts of one contact: J_a^T Sigma^-1 J_a, J_b^T Sigma^-1 J_b and (if
+  // `coupling`) K_ab = J_a^T Sigma^-1 J_b. In world axes J = s [D, -D S; 0, D] with
+  // S = [r]x; with P_t = D^T S_t D, P_r = D^T S_r D (S_t, S_r the translational and rotational
+  // rows of Sigma^-1, 0 where masked or absent) and X = P_t S',
+  //   J^T Sigma^-1 J' = s s' [P_t, -X; S P_t, -S X + P_r],   S P_t = -(P_t S)^T.
+  void body_parts(int c, Mat6 &Kaa, Mat6 &Kbb, Mat6 *Kab) const
   {
-    M3 D, Fa, Fb;
-    frame(c, D);
+    const Mat3 &D = sys_.kinematics(c).frame;
     double st[3], sr[3];
-    const Vec6 w = plain_ ? Vec6::Ones() : weights(c);
     const double *sigma = sys_.sigma().data() + std::size_t(rows_) * c;
+    const Vec6 w = plain_ ? Vec6::Ones() : weights(c);
     for (int r = 0; r < 3; ++r) {
       st[r] = w[r] / sigma[r];
       sr[r] = rows_ == kB ? w[r + 3] / sigma[r + 3] : 0.0;
     }
-    const bool wall = sys_.contacts()[c].is_wall();
-    skew_left(lever(c, 0), D, Fa);
-    if (!wall) skew_left(lever(c, 1), D, Fb);
-    // X^T S Y for 3x3 X, Y and diagonal S.
-    auto xsy = [](const M3 &X, const double *S, const M3 &Y, int i, int k) {
-      return X[0][i] * S[0] * Y[0][k] + X[1][i] * S[1] * Y[1][k] + X[2][i] * S[2] * Y[2][k];
-    };
+    M3 Pt, Pr;
+    for (int i = 0; i < 3; ++i)
+      for (int k = 0; k <= i; ++k) {
+        Pt[i][k] = Pt[k][i] = st[0] * D(0, i) * D(0, k) + st[1] * D(1, i) * D(1, k) +
+            st[2] * D(2, i) * D(2, k);
+        Pr[i][k] = Pr[k][i] = sr[0] * D(0, i) * D(0, k) + sr[1] * D(1, i) * D(1, k) +
+            sr[2] * D(2, i) * D(2, k);
+      }
+    const ContactKinematics &q = sys_.kinematics(c);
+    M3 Xa, Xb, SX;
+    world_side(Pt, Pr, q.ra, Xa, SX, Kaa);
+    if (sys_.contacts()[c].is_wall()) return;
+    world_side(Pt, Pr, q.rb, Xb, SX, Kbb);
+    if (!Kab) return;
+    // K_ab = -[P_t, -X_b; -X_a^T, -S_a X_b + P_r].
+    skew_world_left(q.ra, Xb, SX);
     for (int i = 0; i < 3; ++i)
       for (int k = 0; k < 3; ++k) {
-        const double pt = xsy(D, st, D, i, k), pr = xsy(D, sr, D, i, k);
-        const double dfa = xsy(D, st, Fa, i, k), fad = xsy(Fa, st, D, i, k);
-        Kaa(i, k) = pt;
-        Kaa(i, k + 3) = -dfa;
-        Kaa(i + 3, k) = -fad;
-        Kaa(i + 3, k + 3) = xsy(Fa, st, Fa, i, k) + pr;
-        if (wall) continue;
-        const double dfb = xsy(D, st, Fb, i, k), fbd = xsy(Fb, st, D, i, k);
-        Kbb(i, k) = pt;
-        Kbb(i, k + 3) = -dfb;
-        Kbb(i + 3, k) = -fbd;
-        Kbb(i + 3, k + 3) = xsy(Fb, st, Fb, i, k) + pr;
-        Kab(i, k) = -pt;
-        Kab(i, k + 3) = dfb;
-        Kab(i + 3, k) = fad;
-        Kab(i + 3, k + 3) = -(xsy(Fa, st, Fb, i, k) + pr);
+        (*Kab)(i, k) = -Pt[i][k];
+        (*Kab)(i, k + 3) = Xb[i][k];
+        (*Kab)(i + 3, k) = Xa[k][i];
+        (*Kab)(i + 3, k + 3) = SX[i][k] - Pr[i][k];
       }
   }
 
  private:
+  // X = [r]x M.
+  static void skew_world_left(const Vec3 &r, const M3 &m, M3 &x)
+  {
+    for (int k = 0; k < 3; ++k) {
+      x[0][k] = r[1] * m[2][k] - r[2] * m[1][k];
+      x[1][k] = r[2] * m[0][k] - r[0] * m[2][k];
+      x[2][k] = r[0] * m[1][k] - r[1] * m[0][k];
+    }
+  }
+  // One side's J^T Sigma^-1 J into K, with X = P_t [r]x.
+  static void world_side(const M3 &Pt, const M3 &Pr, const Vec3 &r, M3 &X, M3 &SX, Mat6 &K)
+  {
+    for (int i = 0; i < 3; ++i) {  // X = P_t [r]x, row by row
+      X[i][0] = Pt[i][1] * r[2] - Pt[i][2] * r[1];
+      X[i][1] = Pt[i][2] * r[0] - Pt[i][0] * r[2];
+      X[i][2] = Pt[i][0] * r[1] - Pt[i][1] * r[0];
+    }
+    skew_world_left(r, X, SX);
+    for (int i = 0; i < 3; ++i)
+      for (int k = 0; k < 3; ++k) {
+        K(i, k) = Pt[i][k];
+        K(i, k + 3) = -X[i][k];
+        K(i + 3, k) = -X[k][i];
+        K(i + 3, k + 3) = Pr[i][k] - SX[i][k];
+      }
+  }
+
   const ContactSystem &sys_;
   int rows_;
   bool plain_;  // six rows and no mask: the weights are all one
@@ -533,8 +588,10 @@ std::unique_ptr<Preconditioner> contact_jacobi(const ContactSystem &sys)
   const BlockBuilder blocks(sys);
   const int rows = sys.rows();
   Vector inv(sys.contact_dofs());
-  for (int c = 0; c < sys.num_contacts(); ++c)
+  for (int c = 0; c < sys.num_contacts(); ++c) {
+    blocks.prefetch(c);
     inv.segment(Eigen::Index(rows) * c, rows) = blocks.contact_diagonal(c).head(rows).cwiseInverse();
+  }
   return std::make_unique<DiagonalPreconditioner>(std::move(inv));
 }
 
@@ -543,8 +600,10 @@ std::unique_ptr<Preconditioner> contact_block(const ContactSystem &sys)
   const BlockBuilder blocks(sys);
   const int nc = sys.num_contacts(), rows = sys.rows();
   ForestFactor f(nc, rows);
+  for (int c = 0; c < nc; ++c) f.set_node(c, rows * c, -1, 1);
+  f.link();
   for (int c = 0; c < nc; ++c) {
-    f.set_node(c, rows * c, -1, 1);
+    blocks.prefetch(c);
     blocks.contact_diag(c, f.diag_data(c));
   }
   return finish("block", std::move(f), sys.contact_dofs(), true);
@@ -571,8 +630,10 @@ std::unique_ptr<Preconditioner> contact_fibre(const ContactSystem &sys, const Pr
   for (int c = 0; c < nc; ++c)
     if (node[c] < 0) node[c] = n++;
   ForestFactor f(nc, rows);
+  for (int c = 0; c < nc; ++c) f.set_node(node[c], rows * c, next[c] >= 0 ? node[c] + 1 : -1, 1);
+  f.link();
   for (int c = 0; c < nc; ++c) {
-    f.set_node(node[c], rows * c, next[c] >= 0 ? node[c] + 1 : -1, 1);
+    blocks.prefetch(c, c + 2 < nc ? next[c + 2] : -1);
     blocks.contact_diag(c, f.diag_data(node[c]));
     if (next[c] >= 0) blocks.contact_coupling(c, next[c], f.coupling_data(node[c]));
   }
@@ -619,30 +680,38 @@ std::unique_ptr<Preconditioner> contact_tree(const ContactSystem &sys, const Pre
   for (int c = 0; c < nc; ++c)
     if (contact_node[c] < 0) contact_node[c] = n++;
 
+  // The tree contact's parent: its wall body, or the end nearer the root.
+  auto parent_body = [&](int c) {
+    const Contact &k = contacts[c];
+    return k.is_wall() ? k.a : forest.parent[k.a] == k.b ? k.b : k.a;
+  };
   ForestFactor f(n, rows);
+  for (int i = 0; i < nb; ++i)
+    if (body_node[i] >= 0)
+      f.set_node(body_node[i], -1, forest.parent_contact[i] >= 0 ? body_node[i] + 1 : -1, -1);
+  for (int c = 0; c < nc; ++c)
+    f.set_node(contact_node[c], rows * c,
+               contact_node[c] < tree_nodes ? body_node[parent_body(c)] : -1, 1);
+  f.link();
   const Vector &inv_mass = sys.inv_mass();
   for (int i = 0; i < nb; ++i) {  // body i: -M_i, stored as M_i; -G^T to its parent contact
     if (body_node[i] < 0) continue;
     const int pc = forest.parent_contact[i];
-    f.set_node(body_node[i], -1, pc >= 0 ? body_node[i] + 1 : -1, -1);
     f.set_diag(body_node[i], Vec6(inv_mass.segment<6>(6 * i).cwiseInverse()));
     if (pc >= 0)
       f.coupling(body_node[i]) = -blocks.jacobian(pc, contacts[pc].a == i ? 0 : 1).transpose();
   }
   for (int c = 0; c < nc; ++c) {
-    const Contact &k = contacts[c];
+    blocks.prefetch(c);
     if (contact_node[c] >= tree_nodes) {
-      f.set_node(contact_node[c], rows * c, -1, 1);
       blocks.contact_diag(c, f.diag_data(contact_node[c]));
       continue;
     }
     // In the tree: Sigma_c (identity on padding rows), coupled to its parent body by -G_cj.
-    const int j = k.is_wall() ? k.a : forest.parent[k.a] == k.b ? k.b : k.a;
-    f.set_node(contact_node[c], rows * c, body_node[j], 1);
     Vec6 d = Vec6::Ones();
     for (int r = 0; r < rows; ++r) d[r] = sys.sigma()[Eigen::Index(rows) * c + r];
     f.set_diag(contact_node[c], d);
-    f.coupling(contact_node[c]) = -blocks.jacobian(c, j == k.a ? 0 : 1);
+    f.coupling(contact_node[c]) = -blocks.jacobian(c, parent_body(c) == contacts[c].a ? 0 : 1);
   }
   return finish("tree", std::move(f), sys.contact_dofs(), true);
 }
@@ -670,20 +739,36 @@ std::vector<Mat6> body_blocks(const ContactSystem &sys, const Exchange &ex,
       if ((*link)[i] >= 0) f->coupling((*node)[i]).setZero();
   Mat6 Kaa, Kbb, Kab;
   for (int c = 0; c < sys.num_contacts(); ++c) {
+#if defined(__GNUC__)
+    if (c + BlockBuilder::kPrefetch < sys.num_contacts()) {  // scattered bodies: see prefetch()
+      const Contact &ahead = sys.contacts()[c + BlockBuilder::kPrefetch];
+      __builtin_prefetch(K[ahead.a].data());
+      __builtin_prefetch(K[ahead.a].data() + 16);
+      if (ahead.b >= 0) {
+        __builtin_prefetch(K[ahead.b].data());
+        __builtin_prefetch(K[ahead.b].data() + 16);
+      }
+    }
+#endif
     const Contact &k = sys.contacts()[c];
-    blocks.body_parts(c, Kaa, Kbb, Kab);
+    const bool a_to_b = link && !k.is_wall() && k.a < owned && k.b < owned && (*link)[k.a] == k.b;
+    const bool b_to_a = link && !k.is_wall() && k.a < owned && k.b < owned && (*link)[k.b] == k.a;
+    blocks.body_parts(c, Kaa, Kbb, a_to_b || b_to_a ? &Kab : nullptr);
     K[k.a] += Kaa;
     if (k.is_wall()) continue;
     K[k.b] += Kbb;
-    if (!link || k.a >= owned || k.b >= owned) continue;
-    if ((*link)[k.a] == k.b) f->coupling((*node)[k.a]) += Kab;
-    if ((*link)[k.b] == k.a) f->coupling((*node)[k.b]) += Kab.transpose();
+    if (a_to_b) f->coupling((*node)[k.a]) += Kab;
+    if (b_to_a) f->coupling((*node)[k.b]) += Kab.transpose();
   }
-  Vector col(sys.body_dofs());
-  for (int j = 0; j < kB; ++j) {
-    for (int i = 0; i < nb; ++i) col.segment<6>(6 * i) = K[i].col(j);
-    ex.reverse_sum(col);
-    for (int i = 0; i < owned; ++i) K[i].col(j) = col.segment<6>(6 * i);
+  // One collective flag first, so that serial runs and ghost-free decompositions skip the six
+  // exchanges (every process takes the same branch).
+  if (ex.max(nb > owned ? 1.0 : 0.0) > 0) {
+    Vector col(sys.body_dofs());
+    for (int j = 0; j < kB; ++j) {
+      for (int i = 0; i < nb; ++i) col.segment<6>(6 * i) = K[i].col(j);
+      ex.reverse_sum(col);
+      for (int i = 0; i < owned; ++i) K[i].col(j) = col.segment<6>(6 * i);
+    }
   }
   K.resize(owned);
   return K;
@@ -708,6 +793,7 @@ std::unique_ptr<Preconditioner> body_forest(const char *name, const ContactSyste
   ForestFactor f(owned, kB);
   for (int i = 0; i < owned; ++i)
     f.set_node(node[i], 6 * i, link[i] >= 0 ? node[link[i]] : -1, 1);
+  f.link();
   const std::vector<Mat6> K = body_blocks(sys, ex, &link, &node, &f);
   for (int i = 0; i < owned; ++i) f.set_diag(node[i], K[i]);
   return finish(name, std::move(f), sys.body_dofs(), owned == sys.num_bodies());

@@ -58,17 +58,17 @@ Spectrum dense_spectrum(const LinearOperator &A, const Preconditioner &P)
   // Both are symmetric up to rounding; the solvers read one triangle.
   Ad = 0.5 * (Ad + Ad.transpose()).eval();
   Pd = 0.5 * (Pd + Pd.transpose()).eval();
-  // P^-1 = B B^T, then eig(P^-1 A) = eig(B^T A B): the symmetric generalized problem. The
-  // preconditioners' P^-1 are sparse (block diagonal, or block per fibre or tree), so a sparse
-  // Cholesky keeps B sparse and the products cheap; only the eigenvalue solve is O(n^3).
-  const SparseMatrix Ps = Pd.sparseView(0.0, 0.0);
-  Eigen::SimplicialLLT<SparseMatrix> llt(Ps);
+  // The symmetric generalized problem: with A = B B^T (Cholesky), eig(P^-1 A) =
+  // eig(B^T P^-1 B). A is sparse and its sparse Cholesky stays sparse (the contact graph is
+  // nearly a forest), while P^-1 of the fibre and tree preconditioners is dense per fibre or
+  // tree. So B is sparse, the products are cheap, and only the eigenvalue solve is O(n^3).
+  Eigen::SimplicialLLT<SparseMatrix> llt(Ad.sparseView(0.0, 0.0));
   if (llt.info() != Eigen::Success)
-    throw std::runtime_error("dense_spectrum: the preconditioner is not positive definite");
+    throw std::runtime_error("dense_spectrum: the operator is not positive definite");
   const SparseMatrix L = llt.matrixL();
   const SparseMatrix B = llt.permutationPinv() * L;
-  const Eigen::MatrixXd AB = Ad * B;
-  const Eigen::MatrixXd C = SparseMatrix(B.transpose()) * AB;
+  const Eigen::MatrixXd PB = Pd * B;
+  const Eigen::MatrixXd C = SparseMatrix(B.transpose()) * PB;
   Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> es(C, Eigen::EigenvaluesOnly);
   if (es.info() != Eigen::Success) throw std::runtime_error("dense_spectrum: eigensolver failed");
   const Vector &ev = es.eigenvalues();

@@ -10,7 +10,9 @@ The acceleration is measured from the velocity along the slope between t = 2 and
 - rolling resistance mu_r: stops for tan(theta) < mu_r, else rolls with
   a = 5/7 g (sin(theta) - mu_r cos(theta));
 - twisting resistance: a sphere spinning about the normal stops at the rate
-  mu_t r N / I = mu_t g / (0.4 r).
+  mu_t r N / I = mu_t g / (0.4 r), and stays stopped;
+- a sphere launched at v0 along a flat floor slides, spins up and rolls on at 5/7 v0; with
+  rolling locked it slides to a stop at x = v0^2 / (2 mu g) without spinning.
 Accelerations must agree within 2%; a sticking sphere must not move by more than 1e-3
 diameters (SPOOK's velocity-level friction allows a creep of eps_t F_t / (d dt) per unit time,
 a few 1e-6 here).
@@ -24,7 +26,7 @@ DT = 0.01
 T1_STEP, T2_STEP = 200, 1000
 
 
-def deck(theta_deg, opts, omega_z=0.0):
+def deck(theta_deg, opts, omega_z=0.0, vx=0.0):
     t = math.radians(theta_deg)
     return "\n".join([
         "atom_style sphere",
@@ -36,7 +38,7 @@ def deck(theta_deg, opts, omega_z=0.0):
         "create_box 1 box",
         "create_atoms 1 single 0 0 0.5 units box",
         "set atom 1 diameter 1.0 density 1.0",
-        "velocity all set 0 0 0",
+        "velocity all set %.17g 0 0" % vx,
         "set atom 1 omega 0 0 %.17g" % omega_z,
         "pair_style gran/hooke 1.0 NULL 0.0 NULL 0.0 0",
         "pair_coeff * *",
@@ -97,6 +99,9 @@ def main():
             err = e2e.rel_err(a, expected)
             ck.check(err < 0.02, "%s: acceleration" % tag,
                      "a = %.6g, expected %.6g, rel err %.2g%%" % (a, expected, 100 * err))
+        if "locked" in tag:
+            w = max(abs(row["c_s[4]"]) for row in rows.values())
+            ck.check(w < 1e-6, "%s: rolling locked, no spin" % tag, "max |omega_y| = %.3g" % w)
         if tag.startswith("free_roll") or tag in ("resisted_roll", "body_roll"):
             v, w = rows[T2_STEP]["c_s[3]"], rows[T2_STEP]["c_s[4]"]
             err = e2e.rel_err(w * r, v)
@@ -104,6 +109,32 @@ def main():
                      "omega_y r = %.6g, v = %.6g" % (w * r, v))
         z = rows[T2_STEP]["c_s[2]"]
         ck.check(abs(z - 0.5) < 1e-5, "%s: stays on the floor" % tag, "z = %.10g" % z)
+
+    # a sphere launched along a flat floor: slides, spins up and rolls on at 5/7 v0
+    # (no rolling resistance), or slides to a stop at t = v0 / (mu g) without spinning
+    v0 = 1.0
+    for tag, opts in [("launch_roll", "mu 0.5"), ("launch_roll_rows3", "mu 0.5 rows 3"),
+                      ("launch_locked", "mu 0.5 mu_roll 10")]:
+        run = e2e.run_lmp(args, deck(0.0, opts, vx=v0), "incline_" + tag)
+        if not ck.ran(run, "%s: run completes" % tag):
+            continue
+        rows = {int(row["Step"]): row for row in run.thermo[-1]}
+        v_end, w_end = rows[T2_STEP]["c_s[3]"], rows[T2_STEP]["c_s[4]"]
+        if "locked" in tag:
+            stop = v0 / (mu * g)
+            x_stop = v0 * stop / 2
+            ck.check(abs(v_end) < 1e-6 and abs(rows[T2_STEP]["c_s[1]"] - x_stop) < 0.01,
+                     "%s: slides to a stop at x = v0^2 / (2 mu g)" % tag,
+                     "v = %.3g, x = %.6g, expected %.6g" % (v_end, rows[T2_STEP]["c_s[1]"],
+                                                           x_stop))
+            w = max(abs(row["c_s[4]"]) for row in rows.values())
+            ck.check(w < 1e-6, "%s: rolling locked, no spin" % tag, "max |omega_y| = %.3g" % w)
+        else:
+            ck.check(e2e.rel_err(v_end, 5 / 7 * v0) < 1e-3 and
+                     e2e.rel_err(w_end * r, v_end) < 1e-3,
+                     "%s: rolls on at 5/7 v0 without slipping" % tag,
+                     "v = %.6g (5/7 v0 = %.6g), omega_y r = %.6g" % (v_end, 5 / 7 * v0,
+                                                                    w_end * r))
 
     # twisting resistance: spin about the normal decays at mu_t g / (0.4 r)
     mu_t, w0 = 0.2, 2.0

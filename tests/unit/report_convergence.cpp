@@ -1,5 +1,5 @@
 // Report: Krylov iterations to a relative velocity error of 1e-6, per form x preconditioner x
-// method, on pile_scene(400) with Sigma scaled relative to G M^-1 G^T (design.md section 7).
+// method, on the 400-sphere pile poured by native LAMMPS (tests/data/pile400.dump) with Sigma scaled relative to G M^-1 G^T (design.md section 7).
 //
 // sigma_rel = sigma / mean(diag(G M^-1 G^T)) takes 1e-12 .. 1e-4. Two right-hand sides:
 // the SPOOK rhs with its gap term (inconsistent gaps put part of b into null(G^T)), and the
@@ -176,8 +176,8 @@ TEST(Report, ConvergenceToVelocityError)
 {
   const auto t0 = std::chrono::steady_clock::now();
   SceneParams sp;
-  sp.seed = 1;
-  const ContactSystem pile = pile_scene(kBodies, sp);
+  const ContactSystem pile = lammps_pile_scene(FIBRE_TEST_DATA_DIR "/pile400.dump", sp);
+  ASSERT_EQ(pile.num_bodies(), kBodies);
   const SpookParams &spook = pile.params();
   int walls = 0;
   for (const Contact &c : pile.contacts()) walls += c.is_wall();
@@ -190,7 +190,7 @@ TEST(Report, ConvergenceToVelocityError)
   for (Contact &c : no_gap) c.gap = 0;
   const Vector b_gap = spook_rhs(unit);
   const Vector b_range = spook_rhs(ContactSystem(pile.bodies(), no_gap, 6, spook));
-  std::printf("\npile_scene(%d): %d contacts (%d on the floor, %.2f body-body contacts per "
+  std::printf("\nLAMMPS pile of %d spheres: %d contacts (%d on walls, %.2f body-body contacts per "
               "body), %ld contact rows, %ld body unknowns; mean diag(G M^-1 G^T) = %.4g\n",
               kBodies, pile.num_contacts(), walls, 2.0 * body_contacts / kBodies,
               long(pile.contact_dofs()), long(pile.body_dofs()), mean_diag);

@@ -4,6 +4,8 @@
 #pragma once
 
 #include <cstdint>
+#include <string>
+#include <vector>
 
 #include "fibre/system.hpp"
 
@@ -29,5 +31,25 @@ ContactSystem pile_scene(int n, const SceneParams &p);
 
 // A lone contact between two spheres.
 ContactSystem pair_scene(const SceneParams &p);
+
+// A plane wall: points x with normal . x >= offset are inside (the normal points inward).
+struct Plane {
+  Vec3 normal = Vec3::UnitZ();
+  double offset = 0.0;
+};
+
+// Contacts of a given sphere packing: every pair and every plane with gap below
+// p.contact_tolerance * mean radius (0 = overlapping only). Gaps are geometric (no
+// random overlap is added). Velocities and forces are kept as given.
+ContactSystem packing_scene(std::vector<Body> bodies, const std::vector<Plane> &walls,
+                            const SceneParams &p);
+
+// Spheres from a LAMMPS text dump with columns `id radius mass x y z vx vy vz`
+// (and optionally omegax omegay omegaz). Throws std::runtime_error on a malformed file.
+std::vector<Body> read_sphere_dump(const std::string &path, double gravity = 9.81);
+
+// The 400-sphere Hertz pile poured by native LAMMPS (tests/data/in.pile400) in its 8 x 8 box:
+// floor and four side walls.
+ContactSystem lammps_pile_scene(const std::string &dump_path, const SceneParams &p);
 
 }  // namespace fibre
