@@ -718,68 +718,74 @@ std::unique_ptr<Preconditioner> contact_tree(const ContactSystem &sys, const Pre
 
 // ---- body form ----
 
-// Diagonal blocks of K on owned bodies, complete over processes: ghost copies carry only
-// their local contacts' part (not M), which the exchange adds into the owners. With `link`
-// (link[i]: the body that owned body i is coupled to in the preconditioner, or -1), also
-// K(i, link[i]) into f's coupling of node[i], summed over parallel contacts.
-std::vector<Mat6> body_blocks(const ContactSystem &sys, const Exchange &ex,
-                              const std::vector<int> *link = nullptr,
-                              const std::vector<int> *node = nullptr, ForestFactor *f = nullptr)
+// The diagonal blocks of K on owned bodies, into the packed diagonal of node[i], complete
+// over processes: ghost copies carry only their local contacts' part (not M), which the
+// exchange adds into the owners. With `link` (link[i]: the body that owned body i is coupled
+// to in the preconditioner, or -1), also K(i, link[i]) into the coupling of node[i], summed
+// over parallel contacts. f's topology must be set (link() done).
+void body_blocks(const ContactSystem &sys, const Exchange &ex, const std::vector<int> &node,
+                 const std::vector<int> *link, ForestFactor &f)
 {
   const int nb = sys.num_bodies(), owned = sys.num_owned_bodies();
   const BlockBuilder blocks(sys);
-  std::vector<Mat6> K(nb);
   const Vector &inv_mass = sys.inv_mass();
-  for (int i = 0; i < nb; ++i) {
-    K[i].setZero();
-    if (i < owned) K[i].diagonal() = inv_mass.segment<6>(6 * i).cwiseInverse();
+  for (int i = 0; i < owned; ++i) {
+    Vec6 m = inv_mass.segment<6>(6 * i).cwiseInverse();
+    f.set_diag(node[i], m);
+    if (link && (*link)[i] >= 0) f.coupling(node[i]).setZero();
   }
-  if (link)
-    for (int i = 0; i < owned; ++i)
-      if ((*link)[i] >= 0) f->coupling((*node)[i]).setZero();
+  std::vector<double> ghost(std::size_t(kPacked) * (nb - owned), 0.0);
+  auto packed = [&](int i) {
+    return i < owned ? f.diag_data(node[i]) : ghost.data() + std::size_t(kPacked) * (i - owned);
+  };
+  auto add = [](double *l, const Mat6 &m) {
+    for (int j = 0; j < kB; ++j)
+      for (int i = j; i < kB; ++i) l[at(i, j)] += m(i, j);
+  };
   Mat6 Kaa, Kbb, Kab;
   for (int c = 0; c < sys.num_contacts(); ++c) {
 #if defined(__GNUC__)
     if (c + BlockBuilder::kPrefetch < sys.num_contacts()) {  // scattered bodies: see prefetch()
       const Contact &ahead = sys.contacts()[c + BlockBuilder::kPrefetch];
-      __builtin_prefetch(K[ahead.a].data());
-      __builtin_prefetch(K[ahead.a].data() + 16);
-      if (ahead.b >= 0) {
-        __builtin_prefetch(K[ahead.b].data());
-        __builtin_prefetch(K[ahead.b].data() + 16);
-      }
+      __builtin_prefetch(packed(ahead.a));
+      if (ahead.b >= 0) __builtin_prefetch(packed(ahead.b));
     }
 #endif
     const Contact &k = sys.contacts()[c];
-    const bool a_to_b = link && !k.is_wall() && k.a < owned && k.b < owned && (*link)[k.a] == k.b;
-    const bool b_to_a = link && !k.is_wall() && k.a < owned && k.b < owned && (*link)[k.b] == k.a;
+    const bool inner = link && !k.is_wall() && k.a < owned && k.b < owned;
+    const bool a_to_b = inner && (*link)[k.a] == k.b, b_to_a = inner && (*link)[k.b] == k.a;
     blocks.body_parts(c, Kaa, Kbb, a_to_b || b_to_a ? &Kab : nullptr);
-    K[k.a] += Kaa;
+    add(packed(k.a), Kaa);
     if (k.is_wall()) continue;
-    K[k.b] += Kbb;
-    if (a_to_b) f->coupling((*node)[k.a]) += Kab;
-    if (b_to_a) f->coupling((*node)[k.b]) += Kab.transpose();
+    add(packed(k.b), Kbb);
+    if (a_to_b) f.coupling(node[k.a]) += Kab;
+    if (b_to_a) f.coupling(node[k.b]) += Kab.transpose();
   }
   // One collective flag first, so that serial runs and ghost-free decompositions skip the six
   // exchanges (every process takes the same branch).
   if (ex.max(nb > owned ? 1.0 : 0.0) > 0) {
     Vector col(sys.body_dofs());
     for (int j = 0; j < kB; ++j) {
-      for (int i = 0; i < nb; ++i) col.segment<6>(6 * i) = K[i].col(j);
+      for (int i = 0; i < nb; ++i)
+        for (int r = 0; r < kB; ++r) col[6 * i + r] = packed(i)[r >= j ? at(r, j) : at(j, r)];
       ex.reverse_sum(col);
-      for (int i = 0; i < owned; ++i) K[i].col(j) = col.segment<6>(6 * i);
+      for (int i = 0; i < owned; ++i)
+        for (int r = j; r < kB; ++r) packed(i)[at(r, j)] = col[6 * i + r];
     }
   }
-  K.resize(owned);
-  return K;
 }
 
 std::unique_ptr<Preconditioner> body_jacobi(const ContactSystem &sys, const Exchange &ex)
 {
-  const std::vector<Mat6> K = body_blocks(sys, ex);
+  const int owned = sys.num_owned_bodies();
+  std::vector<int> node(owned);
+  ForestFactor f(owned, kB);
+  for (int i = 0; i < owned; ++i) f.set_node(node[i] = i, 6 * i, -1, 1);
+  f.link();
+  body_blocks(sys, ex, node, nullptr, f);
   Vector inv = Vector::Zero(sys.body_dofs());
-  for (int i = 0; i < sys.num_owned_bodies(); ++i)
-    inv.segment<6>(6 * i) = K[i].diagonal().cwiseInverse();
+  for (int i = 0; i < owned; ++i)
+    for (int r = 0; r < kB; ++r) inv[6 * i + r] = 1.0 / f.diag_data(i)[at(r, r)];
   return std::make_unique<DiagonalPreconditioner>(std::move(inv));
 }
 
@@ -794,8 +800,7 @@ std::unique_ptr<Preconditioner> body_forest(const char *name, const ContactSyste
   for (int i = 0; i < owned; ++i)
     f.set_node(node[i], 6 * i, link[i] >= 0 ? node[link[i]] : -1, 1);
   f.link();
-  const std::vector<Mat6> K = body_blocks(sys, ex, &link, &node, &f);
-  for (int i = 0; i < owned; ++i) f.set_diag(node[i], K[i]);
+  body_blocks(sys, ex, node, &link, f);
   return finish(name, std::move(f), sys.body_dofs(), owned == sys.num_bodies());
 }
 

@@ -43,8 +43,8 @@ struct Spectrum {
   double kappa = 1;       // lambda_max / lambda_min
   double kappa_e = 1;     // lambda_max / lambda_r
   int iterations = 0;     // Lanczos steps (0 for the dense paths)
-  // Lanczos: converged = lambda_1 and lambda_r met the tolerance and kappa_e and the gap
-  // repeated over two checks; certified = besides, the Ritz values at the gap and at the
+  // Lanczos: converged = lambda_1 and lambda_r met the tolerance and kappa_e repeated over
+  // two checks; certified = besides, the Ritz values at the gap and at the
   // bottom settled and no unresolved stretch of the spectrum can hide a larger gap (or an
   // invariant subspace was found). Dense paths: both true.
   bool converged = true;
