@@ -10,9 +10,12 @@ namespace fibre {
 const char *to_string(EdgeWeight w)
 {
   switch (w) {
-    case EdgeWeight::z: return "z";
-    case EdgeWeight::straight: return "straight";
-    case EdgeWeight::impulse: return "impulse";
+  case EdgeWeight::z:
+    return "z";
+  case EdgeWeight::straight:
+    return "straight";
+  case EdgeWeight::impulse:
+    return "impulse";
   }
   return "?";
 }
@@ -64,14 +67,6 @@ void check_impulses(const ContactSystem &sys, EdgeWeight weight, const Vector *i
     throw std::invalid_argument("impulse weight needs one normal impulse per contact");
 }
 
-// The per-edge weight without the walk's history (Kruskal completion of the forest).
-double static_weight(const ContactSystem &sys, EdgeWeight weight, const Vector *impulses, int c)
-{
-  if (weight == EdgeWeight::impulse && impulses) return -(*impulses)[c];
-  const Contact &k = sys.contacts()[c];
-  return std::abs(sys.bodies()[k.a].x.z() - sys.bodies()[k.b].x.z());
-}
-
 // Edge weights for the walk, on flat copies of the positions (the walk's inner loop).
 class WalkWeight {
  public:
@@ -87,15 +82,24 @@ class WalkWeight {
   {
     const double *x = &pos_[3 * std::size_t(from)], *y = &pos_[3 * std::size_t(to)];
     switch (weight_) {
-      case EdgeWeight::z: return std::abs(y[2] - x[2]);
-      case EdgeWeight::impulse: return -impulses_[c];
-      case EdgeWeight::straight: break;
+    case EdgeWeight::z:
+      return std::abs(y[2] - x[2]);
+    case EdgeWeight::impulse:
+      return -impulses_[c];
+    case EdgeWeight::straight:
+      break;
     }
     const double pn = prev.squaredNorm();
     if (pn == 0) return 0.0;  // first edge of a fibre: no preference
     const Vec3 e(y[0] - x[0], y[1] - x[1], y[2] - x[2]);
     const double norms = std::sqrt(e.squaredNorm() * pn);
     return norms > 0 ? 1.0 - std::abs(e.dot(prev)) / norms : 1.0;
+  }
+  // The weight without the walk's history, for the Kruskal completion of the forest.
+  double fixed(int c, int from, int to) const
+  {
+    if (weight_ == EdgeWeight::impulse) return -impulses_[c];
+    return std::abs(pos_[3 * std::size_t(to) + 2] - pos_[3 * std::size_t(from) + 2]);
   }
   Vec3 direction(int from, int to) const
   {
@@ -119,12 +123,11 @@ double edge_weight(const ContactSystem &sys, EdgeWeight weight, const Vector *im
   return WalkWeight(sys, weight, impulses)(c, from, k.a == from ? k.b : k.a, prev_dir);
 }
 
-Fibres build_fibres(const ContactSystem &sys, EdgeWeight weight, const Vector *impulses,
-                    bool include_ghosts)
+namespace {
+
+// Algorithm 4 on a built graph (see Fibres).
+Fibres greedy_fibres(const ContactSystem &sys, const ContactGraph &g, const WalkWeight &cost)
 {
-  check_impulses(sys, weight, impulses);
-  const ContactGraph g = contact_graph(sys, include_ghosts);
-  const WalkWeight cost(sys, weight, impulses);
   const int nb = sys.num_bodies();
   std::vector<char> taken(nb, 0);
 
@@ -190,6 +193,15 @@ Fibres build_fibres(const ContactSystem &sys, EdgeWeight weight, const Vector *i
   f.stats.num_fibres = f.num_fibres();
   f.stats.contacts_in_fibres = static_cast<int>(f.contacts.size());
   return f;
+}
+
+}  // namespace
+
+Fibres build_fibres(const ContactSystem &sys, EdgeWeight weight, const Vector *impulses,
+                    bool include_ghosts)
+{
+  check_impulses(sys, weight, impulses);
+  return greedy_fibres(sys, contact_graph(sys, include_ghosts), WalkWeight(sys, weight, impulses));
 }
 
 Relabelling relabel_for_fibres(const ContactSystem &sys, const Fibres &fibres)
@@ -262,8 +274,10 @@ struct DisjointSets {
 Forest build_forest(const ContactSystem &sys, EdgeWeight weight, const Vector *impulses,
                     bool include_ghosts)
 {
-  const Fibres fibres = build_fibres(sys, weight, impulses, include_ghosts);
+  check_impulses(sys, weight, impulses);
   const ContactGraph g = contact_graph(sys, include_ghosts);
+  const WalkWeight cost(sys, weight, impulses);
+  const Fibres fibres = greedy_fibres(sys, g, cost);
   const int nb = sys.num_bodies(), nc = sys.num_contacts();
   const int limit = include_ghosts ? nb : sys.num_owned_bodies();
 
@@ -278,7 +292,7 @@ Forest build_forest(const ContactSystem &sys, EdgeWeight weight, const Vector *i
   for (int i = 0; i < limit; ++i)
     for (int e = g.start[i]; e < g.start[i + 1]; ++e)
       if (g.neighbour[e] > i && !in_tree[g.contact[e]])
-        rest.emplace_back(static_weight(sys, weight, impulses, g.contact[e]), g.contact[e]);
+        rest.emplace_back(cost.fixed(g.contact[e], i, g.neighbour[e]), g.contact[e]);
   std::sort(rest.begin(), rest.end());
   Forest f;
   f.num_edges = static_cast<int>(fibres.contacts.size());

@@ -9,11 +9,16 @@ namespace fibre {
 const char *to_string(PrecondKind k)
 {
   switch (k) {
-    case PrecondKind::none: return "none";
-    case PrecondKind::jacobi: return "jacobi";
-    case PrecondKind::block: return "block";
-    case PrecondKind::fibre: return "fibre";
-    case PrecondKind::tree: return "tree";
+  case PrecondKind::none:
+    return "none";
+  case PrecondKind::jacobi:
+    return "jacobi";
+  case PrecondKind::block:
+    return "block";
+  case PrecondKind::fibre:
+    return "fibre";
+  case PrecondKind::tree:
+    return "tree";
   }
   return "?";
 }
@@ -46,7 +51,10 @@ constexpr int kPacked = 21;  // lower triangle of a 6x6 block
 constexpr int kBlock = 36;
 
 // Packed lower triangle, column by column: (i, j), i >= j.
-constexpr int at(int i, int j) { return j * kB - j * (j - 1) / 2 + (i - j); }
+constexpr int at(int i, int j)
+{
+  return j * kB - j * (j - 1) / 2 + (i - j);
+}
 
 // ---- 6x6 kernels (fully unrolled: every index below is a compile-time constant) ----
 //
@@ -102,6 +110,78 @@ inline void unit_upper_solve6(const double *l, double *x)
   }
 }
 
+// ---- Recycled factor storage ----
+//
+// A preconditioner is rebuilt every time step with the same few megabytes of factors. Fresh
+// pages cost a page fault per 4 KiB on first touch, about a third of the setup, so the arrays
+// of destroyed factors are kept (per thread, at most kKeep of them) for the next setup.
+class Storage {
+ public:
+  explicit Storage(std::size_t n = 0)
+  {
+    if (n == 0) return;
+    if (Pool *pool = Pool::get()) {
+      std::size_t best = pool->kept.size();
+      for (std::size_t i = 0; i < pool->kept.size(); ++i)
+        if (pool->kept[i].first >= n &&
+            (best == pool->kept.size() || pool->kept[i].first < pool->kept[best].first))
+          best = i;
+      if (best < pool->kept.size()) {
+        size_ = pool->kept[best].first;
+        data_ = std::move(pool->kept[best].second);
+        pool->kept.erase(pool->kept.begin() + static_cast<std::ptrdiff_t>(best));
+        return;
+      }
+    }
+    data_.reset(new double[n]);
+    size_ = n;
+  }
+  Storage(Storage &&) = default;
+  Storage &operator=(Storage &&other)
+  {
+    release();
+    data_ = std::move(other.data_);
+    size_ = other.size_;
+    return *this;
+  }
+  ~Storage() { release(); }
+  double *get() const { return data_.get(); }
+
+ private:
+  struct Pool {
+    static constexpr std::size_t kKeep = 4;
+    std::vector<std::pair<std::size_t, std::unique_ptr<double[]>>> kept;
+    ~Pool() { closed() = true; }
+    static bool &closed()  // trivially destructible: still readable while statics die
+    {
+      thread_local bool flag = false;
+      return flag;
+    }
+    static Pool *get()
+    {
+      if (closed()) return nullptr;
+      thread_local Pool pool;
+      return &pool;
+    }
+  };
+  void release()
+  {
+    if (!data_) return;
+    Pool *pool = Pool::get();
+    if (!pool) return;
+    if (pool->kept.size() == Pool::kKeep) {  // keep the largest arrays
+      std::size_t smallest = 0;
+      for (std::size_t i = 1; i < pool->kept.size(); ++i)
+        if (pool->kept[i].first < pool->kept[smallest].first) smallest = i;
+      if (pool->kept[smallest].first >= size_) return;
+      pool->kept.erase(pool->kept.begin() + static_cast<std::ptrdiff_t>(smallest));
+    }
+    pool->kept.emplace_back(size_, std::move(data_));
+  }
+  std::unique_ptr<double[]> data_;
+  std::size_t size_ = 0;
+};
+
 // ---- Block LDL^T of a matrix whose block graph is a forest ----
 //
 // Nodes are 6x6 blocks, ordered so that every node comes before its parent (leaves first);
@@ -115,7 +195,7 @@ class ForestFactor {
   // Two phases: set_node() for every node, then link(), then the values.
   ForestFactor(int nodes, int dim)
       : dim_(dim), parent_(nodes, -1), offset_(nodes, -1), wslot_(nodes, -1), sign_(nodes, 1),
-        l_(new double[std::size_t(kPacked) * nodes])
+        l_(std::size_t(kPacked) * nodes)
   {
   }
   int nodes() const { return static_cast<int>(parent_.size()); }
@@ -132,9 +212,8 @@ class ForestFactor {
   {
     double *l = l_.get() + std::size_t(kPacked) * n;
     FIBRE_UNROLL
-    for (int j = 0; j < kB; ++j)
-      FIBRE_UNROLL
-      for (int i = j; i < kB; ++i) l[at(i, j)] = d(i, j);
+    for (int j = 0; j < kB; ++j) FIBRE_UNROLL
+    for (int i = j; i < kB; ++i) l[at(i, j)] = d(i, j);
   }
   // Coupling storage for the nodes with a parent only, in node order (the factorization
   // streams through it): setup cost is mostly first touch of fresh memory.
@@ -143,7 +222,7 @@ class ForestFactor {
     int slots = 0;
     for (int n = 0; n < nodes(); ++n)
       if (parent_[n] >= 0) wslot_[n] = slots++;
-    w_.reset(new double[std::size_t(kBlock) * slots]);
+    w_ = Storage(std::size_t(kBlock) * slots);
   }
   // Packed lower triangle of sign_n D_n, to be filled in place.
   double *diag_data(int n) { return l_.get() + std::size_t(kPacked) * n; }
@@ -156,10 +235,7 @@ class ForestFactor {
   // Row-major B_n, to be filled in place.
   double *coupling_data(int n) { return w_.get() + std::size_t(kBlock) * wslot_[n]; }
   // B_n = A(n, parent), for a node with a parent.
-  Eigen::Map<RowMat6> coupling(int n)
-  {
-    return Eigen::Map<RowMat6>(coupling_data(n));
-  }
+  Eigen::Map<RowMat6> coupling(int n) { return Eigen::Map<RowMat6>(coupling_data(n)); }
 
   void factor()
   {
@@ -171,30 +247,27 @@ class ForestFactor {
       double *v = w_.get() + std::size_t(kBlock) * wslot_[n];
       // V = L^-1 B on whole rows.
       FIBRE_UNROLL
-      for (int i = 1; i < kB; ++i)
+      for (int i = 1; i < kB; ++i) FIBRE_UNROLL
+      for (int k = 0; k < i; ++k) {
+        const double lik = l[at(i, k)];
         FIBRE_UNROLL
-        for (int k = 0; k < i; ++k) {
-          const double lik = l[at(i, k)];
-          FIBRE_UNROLL
-          for (int j = 0; j < kB; ++j) v[kB * i + j] -= lik * v[kB * k + j];
-        }
+        for (int j = 0; j < kB; ++j) v[kB * i + j] -= lik * v[kB * k + j];
+      }
       // D_p -= B^T D_n^-1 B = sign_n V^T Delta^-1 V, in the parent's signed storage.
       double sv[kBlock];
       const double s = double(sign_[n] * sign_[p]);
       FIBRE_UNROLL
-      for (int k = 0; k < kB; ++k)
-        FIBRE_UNROLL
-        for (int j = 0; j < kB; ++j) sv[kB * k + j] = s * l[at(k, k)] * v[kB * k + j];
+      for (int k = 0; k < kB; ++k) FIBRE_UNROLL
+      for (int j = 0; j < kB; ++j) sv[kB * k + j] = s * l[at(k, k)] * v[kB * k + j];
       double *dp = l_.get() + std::size_t(kPacked) * p;
       FIBRE_UNROLL
-      for (int b = 0; b < kB; ++b)
+      for (int b = 0; b < kB; ++b) FIBRE_UNROLL
+      for (int a = b; a < kB; ++a) {
+        double t = 0;
         FIBRE_UNROLL
-        for (int a = b; a < kB; ++a) {
-          double t = 0;
-          FIBRE_UNROLL
-          for (int k = 0; k < kB; ++k) t += sv[kB * k + a] * v[kB * k + b];
-          dp[at(a, b)] -= t;
-        }
+        for (int k = 0; k < kB; ++k) t += sv[kB * k + a] * v[kB * k + b];
+        dp[at(a, b)] -= t;
+      }
     }
   }
 
@@ -262,22 +335,23 @@ class ForestFactor {
   std::vector<int> offset_;
   std::vector<int> wslot_;  // position in w_, -1 for roots
   std::vector<signed char> sign_;
-  std::unique_ptr<double[]> l_;  // 21 per node: sign D, then its L Delta L^T factor
-  std::unique_ptr<double[]> w_;  // 36 per node with a parent: B, then V = L^-1 B
+  Storage l_;  // 21 per node: sign D, then its L Delta L^T factor
+  Storage w_;  // 36 per node with a parent: B, then V = L^-1 B
 };
 
 class ForestPreconditioner final : public Preconditioner {
  public:
-  ForestPreconditioner(std::string name, ForestFactor factor, Eigen::Index size,
-                       bool covers_all)
+  ForestPreconditioner(std::string name, ForestFactor factor, Eigen::Index size, bool covers_all)
       : name_(std::move(name)), factor_(std::move(factor)), size_(size), covers_all_(covers_all)
   {
   }
   // Not reentrant: one preconditioner serves one solve at a time (work_ is shared).
   void apply(const Vector &r, Vector &z) const override
   {
-    if (covers_all_) z.resize(size_);
-    else z.setZero(size_);
+    if (covers_all_)
+      z.resize(size_);
+    else
+      z.setZero(size_);
     factor_.solve(r, z, work_);
   }
   std::string name() const override { return name_; }
@@ -362,10 +436,18 @@ class BlockBuilder {
   }
   Skew lever(int c, int side) const
   {
+    Skew q[2];
+    levers(c, q[0], q[1]);
+    return q[side];
+  }
+  // Both sides at once: the frame's cross products are shared.
+  void levers(int c, Skew &qa, Skew &qb) const
+  {
     const ContactKinematics &q = sys_.kinematics(c);
-    const Vec3 &r = side == 0 ? q.ra : q.rb;
     const Vec3 d0 = q.frame.row(0), d1 = q.frame.row(1), d2 = q.frame.row(2);
-    return {r.dot(d1.cross(d0)), r.dot(d2.cross(d0)), r.dot(d2.cross(d1))};
+    const Vec3 x10 = d1.cross(d0), x20 = d2.cross(d0), x21 = d2.cross(d1);
+    qa = {q.ra.dot(x10), q.ra.dot(x20), q.ra.dot(x21)};
+    qb = {q.rb.dot(x10), q.rb.dot(x20), q.rb.dot(x21)};
   }
   int body(int c, int side) const
   {
@@ -391,8 +473,14 @@ class BlockBuilder {
     (void)other;
 #endif
   }
-  double mu(int j) const { return sys_.inv_mass()[6 * j]; }
-  double iota(int j) const { return sys_.inv_mass()[6 * j + 3]; }
+  double mu(int j) const
+  {
+    return sys_.inv_mass()[6 * j];
+  }
+  double iota(int j) const
+  {
+    return sys_.inv_mass()[6 * j + 3];
+  }
 
   // Row weights: 1 for active rows, 0 for masked and padding rows.
   Vec6 weights(int c) const
@@ -409,9 +497,11 @@ class BlockBuilder {
     // Sums over the sides of mu I + iota Q Q^T (top left), iota Q (bottom left), iota I.
     double t00 = 0, t11 = 0, t22 = 0, t10 = 0, t20 = 0, t21 = 0, qa = 0, qb = 0, qc = 0, ri = 0;
     const int sides = sys_.contacts()[c].is_wall() ? 1 : 2;
+    Skew lev[2];
+    levers(c, lev[0], lev[1]);
     for (int side = 0; side < sides; ++side) {
       const int j = body(c, side);
-      const Skew q = lever(c, side);
+      const Skew &q = lev[side];
       const double m = mu(j), i = iota(j);
       t00 += m + i * (q.a * q.a + q.b * q.b);
       t11 += m + i * (q.a * q.a + q.c * q.c);
@@ -424,8 +514,8 @@ class BlockBuilder {
       qc += i * q.c;
       ri += i;
     }
-    const double packed[kPacked] = {t00, t10, t20, 0,   -qa, -qb, t11, t21, qa, 0, -qc,
-                                    t22, qb,  qc,  0,   ri,  0,   0,   ri,  0,  ri};
+    const double packed[kPacked] = {t00, t10, t20, 0, -qa, -qb, t11, t21, qa, 0, -qc,
+                                    t22, qb,  qc,  0, ri,  0,   0,   ri,  0,  ri};
     for (int k = 0; k < kPacked; ++k) l[k] = packed[k];
     if (!plain_) {
       const Vec6 w = weights(c);
@@ -454,11 +544,14 @@ class BlockBuilder {
       for (int k = 0; k < 3; ++k)
         R[i][k] = Dc[i][0] * Dd[k][0] + Dc[i][1] * Dd[k][1] + Dc[i][2] * Dd[k][2];
     bool first = true;
+    Skew lc[2], ld[2];
+    levers(c, lc[0], lc[1]);
+    levers(d, ld[0], ld[1]);
     for (int sc = 0; sc < 2; ++sc)
       for (int sd = 0; sd < 2; ++sd) {
         const int j = body(c, sc);
         if (j < 0 || j != body(d, sd)) continue;
-        const Skew qc = lever(c, sc), qd = lever(d, sd);
+        const Skew &qc = lc[sc], &qd = ld[sd];
         const double s = sc == sd ? 1.0 : -1.0, m = s * mu(j), i = s * iota(j);
         skew_left(qc, R, QR);
         skew_right(R, qd, RQ);
@@ -523,10 +616,10 @@ class BlockBuilder {
     M3 Pt, Pr;
     for (int i = 0; i < 3; ++i)
       for (int k = 0; k <= i; ++k) {
-        Pt[i][k] = Pt[k][i] = st[0] * D(0, i) * D(0, k) + st[1] * D(1, i) * D(1, k) +
-            st[2] * D(2, i) * D(2, k);
-        Pr[i][k] = Pr[k][i] = sr[0] * D(0, i) * D(0, k) + sr[1] * D(1, i) * D(1, k) +
-            sr[2] * D(2, i) * D(2, k);
+        Pt[i][k] = Pt[k][i] =
+            st[0] * D(0, i) * D(0, k) + st[1] * D(1, i) * D(1, k) + st[2] * D(2, i) * D(2, k);
+        Pr[i][k] = Pr[k][i] =
+            sr[0] * D(0, i) * D(0, k) + sr[1] * D(1, i) * D(1, k) + sr[2] * D(2, i) * D(2, k);
       }
     const ContactKinematics &q = sys_.kinematics(c);
     M3 Xa, Xb, SX;
@@ -590,7 +683,8 @@ std::unique_ptr<Preconditioner> contact_jacobi(const ContactSystem &sys)
   Vector inv(sys.contact_dofs());
   for (int c = 0; c < sys.num_contacts(); ++c) {
     blocks.prefetch(c);
-    inv.segment(Eigen::Index(rows) * c, rows) = blocks.contact_diagonal(c).head(rows).cwiseInverse();
+    inv.segment(Eigen::Index(rows) * c, rows) =
+        blocks.contact_diagonal(c).head(rows).cwiseInverse();
   }
   return std::make_unique<DiagonalPreconditioner>(std::move(inv));
 }
@@ -797,8 +891,7 @@ std::unique_ptr<Preconditioner> body_forest(const char *name, const ContactSyste
 {
   const int owned = sys.num_owned_bodies();
   ForestFactor f(owned, kB);
-  for (int i = 0; i < owned; ++i)
-    f.set_node(node[i], 6 * i, link[i] >= 0 ? node[link[i]] : -1, 1);
+  for (int i = 0; i < owned; ++i) f.set_node(node[i], 6 * i, link[i] >= 0 ? node[link[i]] : -1, 1);
   f.link();
   body_blocks(sys, ex, node, &link, f);
   return finish(name, std::move(f), sys.body_dofs(), owned == sys.num_bodies());
@@ -853,19 +946,29 @@ std::unique_ptr<Preconditioner> make_preconditioner(Form form, const ContactSyst
   if (opt.kind == PrecondKind::none) return std::make_unique<IdentityPreconditioner>();
   if (form == Form::contact) {
     switch (opt.kind) {
-      case PrecondKind::jacobi: return contact_jacobi(sys);
-      case PrecondKind::block: return contact_block(sys);
-      case PrecondKind::fibre: return contact_fibre(sys, opt, stats);
-      case PrecondKind::tree: return contact_tree(sys, opt, stats);
-      case PrecondKind::none: break;
+    case PrecondKind::jacobi:
+      return contact_jacobi(sys);
+    case PrecondKind::block:
+      return contact_block(sys);
+    case PrecondKind::fibre:
+      return contact_fibre(sys, opt, stats);
+    case PrecondKind::tree:
+      return contact_tree(sys, opt, stats);
+    case PrecondKind::none:
+      break;
     }
   } else {
     switch (opt.kind) {
-      case PrecondKind::jacobi: return body_jacobi(sys, ex);
-      case PrecondKind::block: return body_block(sys, ex);
-      case PrecondKind::fibre: return body_fibre(sys, ex, opt, stats);
-      case PrecondKind::tree: return body_tree(sys, ex, opt, stats);
-      case PrecondKind::none: break;
+    case PrecondKind::jacobi:
+      return body_jacobi(sys, ex);
+    case PrecondKind::block:
+      return body_block(sys, ex);
+    case PrecondKind::fibre:
+      return body_fibre(sys, ex, opt, stats);
+    case PrecondKind::tree:
+      return body_tree(sys, ex, opt, stats);
+    case PrecondKind::none:
+      break;
     }
   }
   throw std::invalid_argument("unknown preconditioner");

@@ -141,7 +141,9 @@ class Reader {
   {
     tokens.clear();
     std::size_t i = 0;
-    auto blank = [](char c) { return c == ' ' || c == '\t' || c == '\r' || c == '\v' || c == '\f'; };
+    auto blank = [](char c) {
+      return c == ' ' || c == '\t' || c == '\r' || c == '\v' || c == '\f';
+    };
     while (i < line.size()) {
       while (i < line.size() && blank(line[i])) ++i;
       const std::size_t start = i;

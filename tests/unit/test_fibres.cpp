@@ -67,8 +67,8 @@ void expect_valid_fibres(const ContactSystem &sys, const Fibres &f, bool ghosts)
           << "contact " << c << " does not join fibre bodies " << u << ", " << v;
       if (q > 0) {
         const Contact &prev = cs[f.contacts[f.contact_start[k] + q - 1]];
-        const int shared = (prev.a == cs[c].a) + (prev.a == cs[c].b) + (prev.b == cs[c].a) +
-            (prev.b == cs[c].b);
+        const int shared =
+            (prev.a == cs[c].a) + (prev.a == cs[c].b) + (prev.b == cs[c].a) + (prev.b == cs[c].b);
         EXPECT_EQ(shared, 1);
       }
     }
@@ -281,13 +281,15 @@ TEST(Fibres, RelabellingPreservesTheSystem)
     const Vector x = Vector::Random(orig.contact_dofs());
     Vector y, y2;
     ContactSpaceOperator(orig, serial_exchange()).apply(x, y);
-    ContactSpaceOperator(sys, serial_exchange()).apply(relabel_contact_vector(r, sys.rows(), x), y2);
+    ContactSpaceOperator(sys, serial_exchange())
+        .apply(relabel_contact_vector(r, sys.rows(), x), y2);
     EXPECT_LT((y2 - relabel_contact_vector(r, sys.rows(), y)).norm(), 1e-12 * y.norm());
     EXPECT_LT((sys.rhs() - relabel_contact_vector(r, sys.rows(), orig.rhs())).norm(),
               1e-14 * orig.rhs().norm());
     const Vector v = Vector::Random(orig.body_dofs());
     Vector pv(v.size()), kv, kv2;
-    for (int i = 0; i < orig.num_bodies(); ++i) pv.segment<6>(6 * r.new_body[i]) = v.segment<6>(6 * i);
+    for (int i = 0; i < orig.num_bodies(); ++i)
+      pv.segment<6>(6 * r.new_body[i]) = v.segment<6>(6 * i);
     BodySpaceOperator(orig, serial_exchange()).apply(v, kv);
     BodySpaceOperator(sys, serial_exchange()).apply(pv, kv2);
     for (int i = 0; i < orig.num_owned_bodies(); ++i)
@@ -371,8 +373,8 @@ TEST(Forest, SpanningForestProperties)
         auto key = [&](int c) {
           const Contact &k = sys.contacts()[c];
           const double wt = w == EdgeWeight::impulse
-              ? -impulses[c]
-              : std::abs(sys.bodies()[k.a].x.z() - sys.bodies()[k.b].x.z());
+                                ? -impulses[c]
+                                : std::abs(sys.bodies()[k.a].x.z() - sys.bodies()[k.b].x.z());
           return std::make_pair(wt, c);
         };
         std::vector<int> depth(sys.num_bodies(), 0);

@@ -60,14 +60,14 @@ void expect_spd(const Dense &Z, const std::string &what)
 
 // Keeps the entries (i, j) of A whose blocks (of `bs` rows) satisfy keep(bi, bj); diagonal
 // blocks are always kept.
-template <class Keep>
-Dense block_pattern(const Dense &A, int bs, Keep keep)
+template <class Keep> Dense block_pattern(const Dense &A, int bs, Keep keep)
 {
   const int nblocks = static_cast<int>(A.rows() / bs);
   Dense P = Dense::Zero(A.rows(), A.cols());
   for (int bi = 0; bi < nblocks; ++bi)
     for (int bj = 0; bj < nblocks; ++bj)
-      if (bi == bj || keep(bi, bj)) P.block(bs * bi, bs * bj, bs, bs) = A.block(bs * bi, bs * bj, bs, bs);
+      if (bi == bj || keep(bi, bj))
+        P.block(bs * bi, bs * bj, bs, bs) = A.block(bs * bi, bs * bj, bs, bs);
   return P;
 }
 
@@ -79,49 +79,55 @@ Dense reference_matrix(Form form, const ContactSystem &sys, const PrecondOptions
   if (form == Form::contact) {
     const Dense A = test::dense_A(sys);
     switch (opt.kind) {
-      case PrecondKind::none: return Dense::Identity(A.rows(), A.cols());
-      case PrecondKind::jacobi: return Dense(A.diagonal().asDiagonal());
-      case PrecondKind::block: return block_pattern(A, rows, [](int, int) { return false; });
-      case PrecondKind::fibre: {
-        // Principal submatrix on the fibre contacts.
-        std::vector<char> in(sys.num_contacts(), 0);
-        for (int c : build_fibres(sys, opt.weight, opt.impulses, true).contacts) in[c] = 1;
-        return block_pattern(A, rows, [&](int c, int d) { return in[c] && in[d]; });
-      }
-      case PrecondKind::tree: {
-        // Principal submatrix on the forest contacts and all wall contacts.
-        const Forest t = build_forest(sys, opt.weight, opt.impulses, true);
-        std::vector<char> in(sys.num_contacts(), 0);
-        for (int c : t.parent_contact)
-          if (c >= 0) in[c] = 1;
-        for (int c = 0; c < sys.num_contacts(); ++c)
-          if (sys.contacts()[c].is_wall()) in[c] = 1;
-        return block_pattern(A, rows, [&](int c, int d) { return in[c] && in[d]; });
-      }
+    case PrecondKind::none:
+      return Dense::Identity(A.rows(), A.cols());
+    case PrecondKind::jacobi:
+      return Dense(A.diagonal().asDiagonal());
+    case PrecondKind::block:
+      return block_pattern(A, rows, [](int, int) { return false; });
+    case PrecondKind::fibre: {
+      // Principal submatrix on the fibre contacts.
+      std::vector<char> in(sys.num_contacts(), 0);
+      for (int c : build_fibres(sys, opt.weight, opt.impulses, true).contacts) in[c] = 1;
+      return block_pattern(A, rows, [&](int c, int d) { return in[c] && in[d]; });
+    }
+    case PrecondKind::tree: {
+      // Principal submatrix on the forest contacts and all wall contacts.
+      const Forest t = build_forest(sys, opt.weight, opt.impulses, true);
+      std::vector<char> in(sys.num_contacts(), 0);
+      for (int c : t.parent_contact)
+        if (c >= 0) in[c] = 1;
+      for (int c = 0; c < sys.num_contacts(); ++c)
+        if (sys.contacts()[c].is_wall()) in[c] = 1;
+      return block_pattern(A, rows, [&](int c, int d) { return in[c] && in[d]; });
+    }
     }
   }
   const Eigen::Index n = Eigen::Index(kBodyDofs) * owned;
   const Dense K = test::dense_K(sys).topLeftCorner(n, n);
   switch (opt.kind) {
-    case PrecondKind::none: return Dense::Identity(n, n);
-    case PrecondKind::jacobi: return Dense(K.diagonal().asDiagonal());
-    case PrecondKind::block: return block_pattern(K, 6, [](int, int) { return false; });
-    case PrecondKind::fibre: {
-      // K on chain neighbours only.
-      const Fibres f = build_fibres(sys, opt.weight, opt.impulses, false);
-      std::set<std::pair<int, int>> links;
-      for (int k = 0; k < f.num_fibres(); ++k)
-        for (int p = f.body_start[k]; p + 1 < f.body_start[k + 1]; ++p) {
-          links.insert({f.bodies[p], f.bodies[p + 1]});
-          links.insert({f.bodies[p + 1], f.bodies[p]});
-        }
-      return block_pattern(K, 6, [&](int i, int j) { return links.count({i, j}) > 0; });
-    }
-    case PrecondKind::tree: {
-      // K on the forest's edges only.
-      const Forest t = build_forest(sys, opt.weight, opt.impulses, false);
-      return block_pattern(K, 6, [&](int i, int j) { return t.parent[i] == j || t.parent[j] == i; });
-    }
+  case PrecondKind::none:
+    return Dense::Identity(n, n);
+  case PrecondKind::jacobi:
+    return Dense(K.diagonal().asDiagonal());
+  case PrecondKind::block:
+    return block_pattern(K, 6, [](int, int) { return false; });
+  case PrecondKind::fibre: {
+    // K on chain neighbours only.
+    const Fibres f = build_fibres(sys, opt.weight, opt.impulses, false);
+    std::set<std::pair<int, int>> links;
+    for (int k = 0; k < f.num_fibres(); ++k)
+      for (int p = f.body_start[k]; p + 1 < f.body_start[k + 1]; ++p) {
+        links.insert({f.bodies[p], f.bodies[p + 1]});
+        links.insert({f.bodies[p + 1], f.bodies[p]});
+      }
+    return block_pattern(K, 6, [&](int i, int j) { return links.count({i, j}) > 0; });
+  }
+  case PrecondKind::tree: {
+    // K on the forest's edges only.
+    const Forest t = build_forest(sys, opt.weight, opt.impulses, false);
+    return block_pattern(K, 6, [&](int i, int j) { return t.parent[i] == j || t.parent[j] == i; });
+  }
   }
   return Dense();
 }
@@ -129,8 +135,8 @@ Dense reference_matrix(Form form, const ContactSystem &sys, const PrecondOptions
 void expect_matches_reference(Form form, const ContactSystem &sys, const PrecondOptions &opt,
                               double tol, bool coupled)
 {
-  const std::string what = std::string(to_string(form)) + " " + to_string(opt.kind) + " " +
-      to_string(opt.weight);
+  const std::string what =
+      std::string(to_string(form)) + " " + to_string(opt.kind) + " " + to_string(opt.weight);
   FibreStats stats;
   const auto P = make_preconditioner(form, sys, serial_exchange(), opt, &stats);
   const Dense Z = dense_inverse(form, sys, *P);
@@ -144,9 +150,10 @@ void expect_matches_reference(Form form, const ContactSystem &sys, const Precond
     EXPECT_GT(stats.contacts_in_fibres, 0) << what;
     PrecondOptions block = opt;
     block.kind = PrecondKind::block;
-    EXPECT_GT((Rinv - dense_inverse(form, sys, *make_preconditioner(form, sys, serial_exchange(),
-                                                                   block))).norm(),
-              1e-3 * Rinv.norm())
+    EXPECT_GT(
+        (Rinv - dense_inverse(form, sys, *make_preconditioner(form, sys, serial_exchange(), block)))
+            .norm(),
+        1e-3 * Rinv.norm())
         << what;
   }
 }
@@ -182,7 +189,10 @@ TEST(Preconditioners, Names)
   EXPECT_FALSE(parse_precond("ilu", k));
 }
 
-TEST(Preconditioners, Grid) { expect_all(grid_scene(SceneParams{})); }
+TEST(Preconditioners, Grid)
+{
+  expect_all(grid_scene(SceneParams{}));
+}
 
 TEST(Preconditioners, PilesWithWalls)
 {

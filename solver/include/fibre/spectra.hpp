@@ -7,12 +7,15 @@
 // where it occurs, so lambda_r is the last eigenvalue above the gap. A ratio, not a
 // difference, because the gap of interest (null(G^T) at Sigma against the range of G in the
 // contact form; free body motions at M against the constrained ones in the body form) spans
-// decades. With one eigenvalue, or all equal, kappa_e = kappa = 1... lambda_1 / lambda_n.
+// decades. With all eigenvalues equal (or just one) there is no gap: kappa_e = kappa = 1.
+// Without a clear gap the rule still picks the largest ratio, often at the isolated extremes of
+// the spectrum; report the gap ratio with kappa_e so that such cases show.
 //
-// Two ways to get there:
+// Three ways to get there:
 // - dense_spectrum: every eigenvalue, from dense A and P^-1 formed by applying the operator
-//   and the preconditioner to unit vectors, through the symmetric generalized problem. One
-//   process, O(n^3): small systems and cross-checks.
+//   and the preconditioner to unit vectors, through the symmetric generalized problem
+//   (Cholesky A = B B^T, eigenvalues of B^T P^-1 B). One process, O(n^3): up to a few
+//   thousand unknowns, and cross-checks.
 // - lanczos_spectrum: preconditioned Lanczos with full reorthogonalization, using only
 //   applies and the operator's (global) inner product, so it scales and runs under MPI.
 //   Sparse, unconverged Ritz values can pose as gaps: r then points at an unconverged value
@@ -36,7 +39,7 @@ struct Spectrum {
   std::vector<double> eigenvalues;  // descending: all (dense) or the Ritz values (Lanczos)
   std::vector<double> residuals;    // Lanczos: residual bounds (infinite: not computed)
   double lambda_max = 0;
-  double lambda_min = 0;  // Lanczos: the smallest converged Ritz value
+  double lambda_min = 0;  // Lanczos: the smallest Ritz value (an upper bound)
   int r = 0;              // eigenvalues[r] = lambda_r, the last above the largest gap
   double lambda_r = 0;
   double gap_ratio = 1;   // lambda_r / (next eigenvalue below it); 1 with no gap

@@ -1,0 +1,116 @@
+"""Acceptance 7: bad input gives a clear LAMMPS error and a non-zero exit status.
+
+Every keyword with a missing or invalid value, an unknown keyword, a wrong atom style, no
+pair style, a pair style without a usable neighbor list, an unknown or moving region, pair
+forces switched back on, and a 2d box. Each case checks the exit status and that the ERROR
+line names the problem (the keyword and the expected form).
+"""
+
+import fibre_e2e as e2e
+
+BASE = """atom_style {style}
+boundary f f f
+newton off
+comm_modify vel yes
+region box block -3 3 -3 3 0 6 units box
+create_box 1 box
+create_atoms 1 single 0 0 0.5 units box
+{set}
+{pair}
+neighbor 0.2 bin
+timestep 0.01
+{pre}
+fix fc all fibre_contact {args}
+{post}
+run 2
+"""
+
+GRAN = "pair_style gran/hooke 1.0 NULL 0.0 NULL 0.0 0\npair_coeff * *"
+
+TWO_D = """atom_style sphere
+dimension 2
+boundary f f p
+region box block -3 3 -3 3 -0.5 0.5 units box
+create_box 1 box
+create_atoms 1 single 0 0 0 units box
+""" + GRAN + """
+fix fc all fibre_contact
+run 2
+"""
+
+# (name, fix arguments, expected text in the ERROR line, deck overrides)
+CASES = [
+    ("form_invalid", "form primal", "expected 'form body|contact', got 'primal'", {}),
+    ("form_missing", "form", "expected 'form body|contact'", {}),
+    ("solver_invalid", "solver bicgstab", "expected 'solver uzawa|cr|minres|direct', got "
+     "'bicgstab'", {}),
+    ("precond_invalid", "precond ilu", "expected 'precond none|jacobi|block|fibre|tree', got "
+     "'ilu'", {}),
+    ("weight_invalid", "weight mass", "expected 'weight z|straight|impulse', got 'mass'", {}),
+    ("tol_negative", "tol -1e-6", "expected 'tol <positive number>', got '-1e-6'", {}),
+    ("tol_text", "tol small", "expected 'tol <positive number>', got 'small'", {}),
+    ("tol_missing", "mu 0.3 tol", "expected 'tol <positive number>'", {}),
+    ("maxiter_zero", "maxiter 0", "expected 'maxiter <positive integer>', got '0'", {}),
+    ("maxiter_real", "maxiter 2.5", "expected 'maxiter <positive integer>', got '2.5'", {}),
+    ("compliance_one", "compliance 1e-6", "expected 'compliance auto' or 'compliance <eps_n> "
+     "<eps_t>'", {}),
+    ("compliance_negative", "compliance -1 1e-6", "'compliance <eps_n> <eps_t>' (positive "
+     "numbers), got '-1'", {}),
+    ("damping_zero", "damping 0", "expected 'damping <positive number of steps>', got '0'", {}),
+    ("mu_negative", "mu -0.1", "expected 'mu <non-negative number>', got '-0.1'", {}),
+    ("mu_roll_text", "mu_roll rough", "expected 'mu_roll <non-negative number>', got 'rough'",
+     {}),
+    ("mu_twist_missing", "mu_twist", "expected 'mu_twist <non-negative number>'", {}),
+    ("rows_invalid", "rows 4", "expected 'rows 3|6', got '4'", {}),
+    ("active_set_zero", "active_set 0", "expected 'active_set <positive integer>', got '0'",
+     {}),
+    ("wall_kind", "wall cylinder 1 2", "'wall xplane|yplane|zplane <lo|NULL> <hi|NULL>' or "
+     "'wall region <region-ID>', got 'cylinder'", {}),
+    ("wall_plane_missing", "wall zplane 0.0", "'wall xplane|yplane|zplane <lo|NULL> "
+     "<hi|NULL>'", {}),
+    ("wall_plane_null", "wall zplane NULL NULL", "at least one of lo and hi", {}),
+    ("wall_plane_order", "wall xplane 2 -2", "lo < hi", {}),
+    ("wall_plane_text", "wall yplane low 2", "got 'low'", {}),
+    ("wall_region_missing", "wall region", "'wall region <region-ID>'", {}),
+    ("wall_region_unknown", "wall region nowhere", "Region ID 'nowhere' for fix fibre_contact "
+     "'wall region' does not exist", {}),
+    ("export_zero", "export 0 sys", "expected 'export <N> <file-prefix>'", {}),
+    ("export_missing_prefix", "export 10", "expected 'export <N> <file-prefix>'", {}),
+    ("unknown_keyword", "mu 0.3 stiffness 1e5", "got 'stiffness'", {}),
+    ("rows3_rolling", "rows 3 mu_roll 0.1", "mu_roll and mu_twist need 'rows 6'", {}),
+    ("atom_style", "", "requires atom attributes radius, rmass, omega and torque",
+     {"style": "atomic", "set": "mass 1 1.0"}),
+    ("no_pair_style", "", "requires a granular pair style for its neighbor list",
+     {"pair": ""}),
+    ("pair_not_granular", "", "requires a granular pair style (gran/hooke",
+     {"pair": "pair_style lj/cut 2.5\npair_coeff * * 1.0 1.0"}),
+    ("pair_after_fix", "", "define the pair style before fix fibre_contact",
+     {"pair": "", "post": GRAN}),
+    ("pair_compute_yes", "", "pair style's force computation is on",
+     {"post": "pair_modify compute yes"}),
+    ("moving_region", "wall region cup", "does not support moving region 'cup'",
+     {"pre": "variable vz equal 0.1*time\n"
+             "region cup cylinder z 0 0 2.5 0 5 side in move NULL NULL v_vz units box"}),
+    ("two_d", "", "requires a 3d simulation", {"deck": TWO_D}),
+]
+
+
+def main():
+    args = e2e.parse_args()
+    ck = e2e.Checks("bad input: %d cases" % len(CASES))
+    for name, fix_args, expected, over in CASES:
+        fields = {"style": "sphere", "set":
+                  "set atom 1 diameter 1.0 density 1.0", "pair": GRAN, "pre": "", "post": "",
+                  "args": fix_args}
+        fields.update(over)
+        deck = fields["deck"] if "deck" in fields else BASE.format(**fields)
+        run = e2e.run_lmp(args, deck, "bad_" + name, timeout=120)
+        err = run.error_line()
+        ck.check(run.rc != 0 and expected in err and "ERROR" in err,
+                 "%s: '%s' fails" % (name, fix_args) if fix_args else "%s fails" % name,
+                 "rc %d, %s" % (run.rc, err if err else "no ERROR line"))
+    ck.close()
+
+
+if __name__ == "__main__":
+    main()
