@@ -207,14 +207,6 @@ class ForestFactor {
     parent_[n] = parent;
     sign_[n] = static_cast<signed char>(sign);
   }
-  // sign_n D_n (positive definite; the lower triangle is read).
-  void set_diag(int n, const Mat6 &d)
-  {
-    double *l = l_.get() + std::size_t(kPacked) * n;
-    FIBRE_UNROLL
-    for (int j = 0; j < kB; ++j) FIBRE_UNROLL
-    for (int i = j; i < kB; ++i) l[at(i, j)] = d(i, j);
-  }
   // Coupling storage for the nodes with a parent only, in node order (the factorization
   // streams through it): setup cost is mostly first touch of fresh memory.
   void link()
@@ -247,26 +239,32 @@ class ForestFactor {
       double *v = w_.get() + std::size_t(kBlock) * wslot_[n];
       // V = L^-1 B on whole rows.
       FIBRE_UNROLL
-      for (int i = 1; i < kB; ++i) FIBRE_UNROLL
-      for (int k = 0; k < i; ++k) {
-        const double lik = l[at(i, k)];
+      for (int i = 1; i < kB; ++i) {
         FIBRE_UNROLL
-        for (int j = 0; j < kB; ++j) v[kB * i + j] -= lik * v[kB * k + j];
+        for (int k = 0; k < i; ++k) {
+          const double lik = l[at(i, k)];
+          FIBRE_UNROLL
+          for (int j = 0; j < kB; ++j) v[kB * i + j] -= lik * v[kB * k + j];
+        }
       }
       // D_p -= B^T D_n^-1 B = sign_n V^T Delta^-1 V, in the parent's signed storage.
       double sv[kBlock];
       const double s = double(sign_[n] * sign_[p]);
       FIBRE_UNROLL
-      for (int k = 0; k < kB; ++k) FIBRE_UNROLL
-      for (int j = 0; j < kB; ++j) sv[kB * k + j] = s * l[at(k, k)] * v[kB * k + j];
+      for (int k = 0; k < kB; ++k) {
+        FIBRE_UNROLL
+        for (int j = 0; j < kB; ++j) sv[kB * k + j] = s * l[at(k, k)] * v[kB * k + j];
+      }
       double *dp = l_.get() + std::size_t(kPacked) * p;
       FIBRE_UNROLL
-      for (int b = 0; b < kB; ++b) FIBRE_UNROLL
-      for (int a = b; a < kB; ++a) {
-        double t = 0;
+      for (int b = 0; b < kB; ++b) {
         FIBRE_UNROLL
-        for (int k = 0; k < kB; ++k) t += sv[kB * k + a] * v[kB * k + b];
-        dp[at(a, b)] -= t;
+        for (int a = b; a < kB; ++a) {
+          double t = 0;
+          FIBRE_UNROLL
+          for (int k = 0; k < kB; ++k) t += sv[kB * k + a] * v[kB * k + b];
+          dp[at(a, b)] -= t;
+        }
       }
     }
   }
@@ -975,3 +973,5 @@ std::unique_ptr<Preconditioner> make_preconditioner(Form form, const ContactSyst
 }
 
 }  // namespace fibre
+
+#undef FIBRE_UNROLL

@@ -95,7 +95,8 @@ Fibres relabelled(const Fibres &fibres, const Relabelling &r);
 // Builds nothing: permutes `sys` by relabel_for_fibres and renumbers `fibres` in place, so
 // that afterwards fibre f's contacts are contact_start[f] .. contact_start[f+1]-1.
 Relabelling relabel_system(ContactSystem &sys, Fibres &fibres);
-// A contact-space vector (rows entries per contact) in the new numbering.
+// A contact-space vector (rows entries per contact) in the new numbering; rows = 1 for
+// per-contact numbers such as the impulses of EdgeWeight::impulse.
 Vector relabel_contact_vector(const Relabelling &r, int rows, const Vector &x);
 
 // Rooted spanning forest of the body graph: the fibres (built with the same weight), then the
