@@ -108,7 +108,7 @@ FixFibreContact::FixFibreContact(LAMMPS *lmp, int narg, char **arg) : Fix(lmp, n
   comm_reverse = fibre_lmp::LammpsExchange::kValuesPerAtom;
   maxexchange = 1 + kMaxSlots * kSlotSize;
 
-  opt_.form = fibre::Form::body;
+  opt_.form = fibre::Form::contact;
   opt_.solver = fibre::SolverKind::cr;
   opt_.precond.kind = fibre::PrecondKind::block;
   opt_.precond.weight = fibre::EdgeWeight::z;

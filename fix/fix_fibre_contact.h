@@ -105,7 +105,7 @@ class FixFibreContact : public Fix {
   fibre::StepOptions opt_;
   bool compliance_auto_ = true;
   double compliance_n_ = 0.0, compliance_t_ = 0.0;
-  double compliance_factor_ = 1e-3;  // auto: eps = factor * dt^2 / m_min
+  double compliance_factor_ = 1e-2;  // auto: eps = factor * dt^2 / m_min
   double damping_ = 2.0;
   int rows_ = 6;
   std::vector<Wall> walls_;

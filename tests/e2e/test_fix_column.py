@@ -3,7 +3,7 @@
 Six spheres of different sizes, stacked exactly touching on a zplane wall under gravity,
 for 1000 steps with every solver and both forms. Checks:
 - the column settles to the compliant static solution: every sphere sits lower by the sum
-  of eps_n * (weight carried) of the contacts below it (eps_n = 1e-3 dt^2 / m_min, the
+  of eps_n * (weight carried) of the contacts below it (eps_n = 1e-2 dt^2 / m_min, the
   default), to 1%;
 - then it stays at rest: drift between step 500 and step 1000 below 1e-9 diameters in
   contact form (body form: 5e-7, MUMPS: 1e-12), final kinetic energy below 1e-10 (MUMPS:
@@ -81,7 +81,7 @@ def main():
         ("fibre_rows3", "form body precond fibre rows 3", 1e-3, 1e-10, 5e-7),
         ("tree_contact", "form contact precond tree", 1e-5, 1e-10, 1e-9),
     ]
-    eps = 1e-3 * DT ** 2 / min(masses)
+    eps = 1e-2 * DT ** 2 / min(masses)
     carried = [GRAVITY * sum(masses[i:]) for i in range(len(masses))]  # by the contact below i
     sink = [eps * sum(carried[: i + 1]) for i in range(len(masses))]
     for tag, opts, impulse_tol, ke_bound, drift_bound in cases:
@@ -124,7 +124,9 @@ def main():
                  "contacts, f_fc[10] converged" % tag,
                  "%g %g %g" % (run.last("f_fc[3]"), run.last("f_fc[11]"), run.last("f_fc[10]")))
         overlap = run.last("f_fc[7]")
-        ck.check(0 <= overlap < 1e-5, "%s: f_fc[7] overlap tiny" % tag, "%.3g" % overlap)
+        floor = eps * GRAVITY * sum(masses)  # the floor contact carries everything
+        ck.check(e2e.rel_err(overlap, floor) < 1e-2, "%s: f_fc[7] = deepest overlap = eps_n "
+                 "* weight" % tag, "%.4g, predicted %.4g" % (overlap, floor))
     ck.close()
 
 

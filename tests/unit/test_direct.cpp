@@ -324,10 +324,10 @@ TEST(DirectMPI, DistributedBodyFormMatchesDense)
 {
   if (world_size() < 2) GTEST_SKIP() << "needs mpirun (see LaunchedUnderMpirun)";
   SceneParams p;
-  distributed_matches_serial(pile_scene(150, p), Form::body);
-  distributed_matches_serial(pile_scene(150, p), Form::contact);
+  distributed_matches_serial(pile_scene(80, p), Form::body);
+  distributed_matches_serial(pile_scene(80, p), Form::contact);
   p.rows = 3;
-  distributed_matches_serial(pile_scene(90, p), Form::body);
+  distributed_matches_serial(pile_scene(50, p), Form::body);
 }
 
 TEST(DirectMPI, DistributedCholeskyRoutesEntries)
@@ -365,7 +365,7 @@ TEST(DirectMPI, DistributedLanczosMatchesDense)
   // operators' global inner products, ghosts kept out of the body-form start vector.
   if (world_size() < 2) GTEST_SKIP() << "needs mpirun (see LaunchedUnderMpirun)";
   SceneParams p;
-  const ContactSystem full = pile_scene(20, p);
+  const ContactSystem full = pile_scene(12, p);
   const LocalPart part = split(full, world_rank(), world_size());
   const SlabExchange ex(MPI_COMM_WORLD, full.num_bodies(), part.l2g,
                         part.sys.num_owned_bodies());
