@@ -270,25 +270,26 @@ void FixFibreContact::parse_args(int narg, char **arg)
       Wall w;
       const std::string kind = val;
       if (kind == "region") {
-        if (iarg + 2 >= narg) illegal(e);
+        if (iarg + 2 >= narg) illegal("'wall region <region-ID>'");
         w.kind = REGION;
         w.region_id = arg[iarg + 2];
         iarg += 3;
       } else if (kind == "xplane" || kind == "yplane" || kind == "zplane") {
         w.kind = kind == "xplane" ? XPLANE : kind == "yplane" ? YPLANE : ZPLANE;
-        if (iarg + 3 >= narg) illegal(e);
+        const std::string ep = "'wall " + kind + " <lo|NULL> <hi|NULL>'";
+        if (iarg + 3 >= narg) illegal(ep);
         const char *lo = arg[iarg + 2], *hi = arg[iarg + 3];
         if (std::strcmp(lo, "NULL") != 0) {
-          if (!to_double(lo, w.lo)) illegal(e, lo);
+          if (!to_double(lo, w.lo)) illegal(ep, lo);
           w.has_lo = true;
         }
         if (std::strcmp(hi, "NULL") != 0) {
-          if (!to_double(hi, w.hi)) illegal(e, hi);
+          if (!to_double(hi, w.hi)) illegal(ep, hi);
           w.has_hi = true;
         }
-        if (!w.has_lo && !w.has_hi) illegal("at least one of lo and hi in " + e + " to be a number");
+        if (!w.has_lo && !w.has_hi) illegal(ep + " with at least one of lo and hi a number");
         if (w.has_lo && w.has_hi && !(w.lo < w.hi))
-          illegal("lo < hi in " + e, (std::string(lo) + " " + hi).c_str());
+          illegal(ep + " with lo < hi", (std::string(lo) + " " + hi).c_str());
         iarg += 4;
       } else {
         illegal(e, val);
@@ -795,8 +796,8 @@ void FixFibreContact::fill_local_output(const std::vector<Found> &found,
 
 /* ---------------------------------------------------------------------- */
 
-void FixFibreContact::export_system(const fibre::ContactSystem &sys, const std::vector<Found> &found,
-                                    const fibre::Vector *lambda)
+void FixFibreContact::export_system(const fibre::ContactSystem &sys,
+                                    const std::vector<Found> &found, const fibre::Vector *lambda)
 {
   const std::string base = export_prefix_ + "." +
                            std::to_string(static_cast<long long>(update->ntimestep)) + "." +

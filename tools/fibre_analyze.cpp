@@ -49,8 +49,12 @@ namespace {
 
 constexpr int kReportIteration = 100;     // thesis Table 1: r_r and v_e at 100 iterations
 constexpr double kVelocityTarget = 1e-6;  // iterations to ve_rel <= this
-// Dense spectra up to this many unknowns (O(n^3) time, three n x n matrices in memory).
+// --kappa auto: dense spectra up to kDenseMaxSize unknowns (O(n^3) time, three n x n matrices
+// in memory); above that Lanczos with at most kAutoLanczosSteps steps, and the dense path after
+// all when Lanczos does not converge and n <= kDenseFallbackSize (about 2 minutes at 6,000).
 constexpr Eigen::Index kDenseMaxSize = 3000;
+constexpr Eigen::Index kDenseFallbackSize = 8000;
+constexpr int kAutoLanczosSteps = 500;
 constexpr int kNormLanczosSteps = 60;  // Lanczos steps for the ||A||_2 estimate
 
 const char *const kUsage =
@@ -75,9 +79,10 @@ options:
                                OUT_PREFIX_<form>_<precond>.csv, the kappa_e table to
                                OUT_PREFIX_kappa.csv, and print kappa_e
   --kappa dense|lanczos|auto   how to compute the spectra (default auto: dense up to 3000
-                               unknowns, above that the body-space spectrum for the contact
-                               form without preconditioner, Lanczos otherwise); without
-                               --spectra it prints the kappa_e table and writes no files
+                               unknowns; above that the body-space spectrum for the contact
+                               form without preconditioner, otherwise Lanczos (500 steps),
+                               dense after all when that does not converge and n <= 8000);
+                               without --spectra it prints the kappa_e table, writes no files
   --sigma-scale S              multiply Sigma (every compliance) by S > 0 (default 1)
   -h, --help                   print this text
 
@@ -517,8 +522,8 @@ const IterationRow *row_at_report(const Run &run)
 
 void print_run_header()
 {
-  std::printf("  %-7s %-6s %6s %-14s %9s %9s %9s %9s %14s %8s %7s\n", "precond", "method",
-              "iters", "stop", "r_r@100", "rb@100", "v_e@100", "ve_rel", "best ve_rel(k)",
+  std::printf("  %-7s %-6s %6s %-14s %9s %9s %9s %10s %14s %8s %7s\n", "precond", "method",
+              "iters", "stop", "r_r@100", "rb@100", "v_e@100", "ve_rel@100", "best ve_rel(k)",
               "to_1e-6", "s");
 }
 
@@ -535,7 +540,7 @@ void print_run(const Run &run)
   }
   const std::string best_s =
       best ? sci(best->ve_rel) + "(" + std::to_string(best->iteration) + ")" : "-";
-  std::printf("  %-7s %-6s %6d %-14s %9s %9s %9s %9s %14s %8s %7.2f\n", to_string(run.kind),
+  std::printf("  %-7s %-6s %6d %-14s %9s %9s %9s %10s %14s %8s %7.2f\n", to_string(run.kind),
               to_string(run.method), run.result.iterations, to_string(run.result.reason),
               at ? (sci(at->rr) + mark).c_str() : "-", at ? (sci(at->rb) + mark).c_str() : "-",
               at ? (sci(at->ve) + mark).c_str() : "-",
@@ -571,22 +576,29 @@ SpectrumRun compute_spectrum(const FormSetup &fs, const PrecondEntry &pe,
   run.kind = pe.kind;
   run.n = fs.op->size();
   const auto t0 = std::chrono::steady_clock::now();
-  const bool small = run.n <= kDenseMaxSize;
+  const bool automatic = how == KappaMethod::automatic;
   const bool body_space = fs.form == Form::contact && pe.kind == PrecondKind::none &&
                           uniform_sigma(sys) && sys.body_dofs() <= kDenseMaxSize;
-  if (how == KappaMethod::dense || (how == KappaMethod::automatic && small)) {
+  if (how == KappaMethod::dense || (automatic && run.n <= kDenseMaxSize)) {
     run.s = dense_spectrum(*fs.op, *pe.P);
     run.method = "dense";
-  } else if (how == KappaMethod::automatic && body_space) {
+  } else if (automatic && body_space) {
     run.s = body_space_spectrum(sys);
     run.method = "body-space";
   } else {
-    run.s = lanczos_spectrum(fs.form, sys, serial_exchange(), *pe.P);
+    LanczosOptions lo;
+    if (automatic) lo.max_steps = kAutoLanczosSteps;
+    run.s = lanczos_spectrum(fs.form, sys, serial_exchange(), *pe.P, lo);
     run.complete = false;
     run.method = "lanczos " + std::to_string(run.s.iterations) +
                  (run.s.certified   ? " certified"
                   : run.s.converged ? " converged"
                                     : " NOT converged");
+    if (automatic && !run.s.converged && run.n <= kDenseFallbackSize) {
+      run.s = dense_spectrum(*fs.op, *pe.P);
+      run.complete = true;
+      run.method = "dense (" + run.method + ")";
+    }
   }
   run.seconds = seconds_since(t0);
   return run;
@@ -615,14 +627,17 @@ void print_kappa_table(const std::vector<SpectrumRun> &runs)
   std::printf("\n== kappa_e = lambda_1 / lambda_r of A (none) and P^-1 A; r = the last "
               "eigenvalue above the largest ratio of consecutive sorted eigenvalues\n");
   std::printf("   dense: all eigenvalues; body-space: the exact spectrum of A through "
-              "M^-1/2 G^T G M^-1/2 (uniform Sigma); lanczos: Ritz values\n");
+              "M^-1/2 G^T G M^-1/2 (uniform Sigma); lanczos: Ritz values\n"
+              "   (lambda_1 and lambda_r converged, the count above the gap unknown: '-')\n");
   std::printf("  %-8s %-7s %6s %11s %11s %11s %11s %9s %9s  %-26s %7s\n", "form", "precond", "n",
               "kappa_e", "kappa", "lambda_1", "lambda_r", "above_gap", "gap", "method", "s");
-  for (const SpectrumRun &r : runs)
-    std::printf("  %-8s %-7s %6ld %11.4g %11.4g %11.4g %11.4g %9d %9.3g  %-26s %7.2f\n",
+  for (const SpectrumRun &r : runs) {
+    const std::string above = r.complete ? std::to_string(r.s.r + 1) : "-";
+    std::printf("  %-8s %-7s %6ld %11.4g %11.4g %11.4g %11.4g %9s %9.3g  %-26s %7.2f\n",
                 to_string(r.form), to_string(r.kind), long(r.n), r.s.kappa_e, r.s.kappa,
-                r.s.lambda_max, r.s.lambda_r, r.s.r + 1, r.s.gap_ratio, r.method.c_str(),
+                r.s.lambda_max, r.s.lambda_r, above.c_str(), r.s.gap_ratio, r.method.c_str(),
                 r.seconds);
+  }
   std::fflush(stdout);
 }
 

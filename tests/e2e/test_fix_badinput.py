@@ -66,12 +66,15 @@ CASES = [
      {}),
     ("wall_kind", "wall cylinder 1 2", "'wall xplane|yplane|zplane <lo|NULL> <hi|NULL>' or "
      "'wall region <region-ID>', got 'cylinder'", {}),
-    ("wall_plane_missing", "wall zplane 0.0", "'wall xplane|yplane|zplane <lo|NULL> "
-     "<hi|NULL>'", {}),
-    ("wall_plane_null", "wall zplane NULL NULL", "at least one of lo and hi", {}),
-    ("wall_plane_order", "wall xplane 2 -2", "lo < hi", {}),
-    ("wall_plane_text", "wall yplane low 2", "got 'low'", {}),
-    ("wall_region_missing", "wall region", "'wall region <region-ID>'", {}),
+    ("wall_plane_missing", "wall zplane 0.0", "expected 'wall zplane <lo|NULL> <hi|NULL>'",
+     {}),
+    ("wall_plane_null", "wall zplane NULL NULL", "expected 'wall zplane <lo|NULL> <hi|NULL>' "
+     "with at least one of lo and hi a number", {}),
+    ("wall_plane_order", "wall xplane 2 -2", "expected 'wall xplane <lo|NULL> <hi|NULL>' with "
+     "lo < hi, got '2 -2'", {}),
+    ("wall_plane_text", "wall yplane low 2", "expected 'wall yplane <lo|NULL> <hi|NULL>', got "
+     "'low'", {}),
+    ("wall_region_missing", "wall region", "expected 'wall region <region-ID>'", {}),
     ("wall_region_unknown", "wall region nowhere", "Region ID 'nowhere' for fix fibre_contact "
      "'wall region' does not exist", {}),
     ("export_zero", "export 0 sys", "expected 'export <N> <file-prefix>'", {}),

@@ -11,8 +11,8 @@
   conserved, no energy gain.
 - A sphere dropped onto a floor: total energy (kinetic + rotational + potential, the
   potential taken at the midpoint z + dt vz / 2 of the next drift, which the scheme conserves
-  exactly in free fall) never grows, the overlap stays below v_impact dt and decays, the sphere comes to rest on the
-  floor.
+  exactly in free fall) never grows, the overlap stays below v_impact dt and decays, the
+  sphere comes to rest on the floor.
 """
 
 import math

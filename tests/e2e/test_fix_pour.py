@@ -54,7 +54,8 @@ compute ke all ke
 compute zav all reduce ave z
 compute pr all property/atom radius
 compute dmin all reduce min c_pr
-thermo_style custom step atoms c_ke c_rot c_zav f_fc[1] f_fc[2] f_fc[3] f_fc[6] f_fc[7] f_fc[9] f_fc[10] f_fc[12] c_dmin
+thermo_style custom step atoms c_ke c_rot c_zav f_fc[1] f_fc[2] f_fc[3] f_fc[6] f_fc[7] &
+             f_fc[9] f_fc[10] f_fc[12] c_dmin
 thermo_modify lost ignore norm no format float %.12g
 thermo 100
 run {steps}

@@ -32,7 +32,8 @@ timestep 0.01
 """
 
 FIXES = """fix g all gravity 1.0 vector 0 0 -1
-fix {fid} all fibre_contact mu 0.5 mu_roll 0.05 wall xplane -0.55 4.95 wall yplane -0.55 4.95 wall zplane -0.55 13.0
+fix {fid} all fibre_contact mu 0.5 mu_roll 0.05 wall xplane -0.55 4.95 &
+    wall yplane -0.55 4.95 wall zplane -0.55 13.0
 compute ke all ke
 thermo_style custom step c_ke f_{fid}[1] f_{fid}[3] f_{fid}[6] f_{fid}[7]
 thermo_modify format float %.17g

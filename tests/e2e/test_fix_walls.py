@@ -70,7 +70,8 @@ timestep 0.005
 fix fc all fibre_contact mu 0.0 wall xplane -2 2 wall yplane -2 2 wall zplane -2 2
 compute xmax all reduce max x y z
 compute xmin all reduce min x y z
-thermo_style custom step atoms c_xmin[1] c_xmin[2] c_xmin[3] c_xmax[1] c_xmax[2] c_xmax[3] f_fc[7] f_fc[11]
+thermo_style custom step atoms c_xmin[1] c_xmin[2] c_xmin[3] c_xmax[1] c_xmax[2] c_xmax[3] &
+             f_fc[7] f_fc[11]
 thermo_modify format float %.10g
 thermo 10
 run 1000
