@@ -5,7 +5,8 @@ set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 cd "$root"
 bash cmake/install-deps.sh
-cmake -S . -B build -DCMAKE_BUILD_TYPE=RelWithDebInfo >/dev/null
+cmake -S . -B build -DCMAKE_BUILD_TYPE=RelWithDebInfo -DFIBRE_BUILD_FIX=ON -DFIBRE_BUILD_TESTS=ON \
+  -DFIBRE_BUILD_BENCH=ON -DFIBRE_SANITIZE=OFF >/dev/null
 cmake --build build -j"$(nproc)" --target lmp_fibre
 cd examples/pour
 "$root/build/fix/lmp_fibre" -in in.pour.fibre "$@"

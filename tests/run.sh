@@ -13,7 +13,8 @@ jobs="$(nproc)"
 bash cmake/install-deps.sh
 
 echo "== normal build =="
-cmake -S . -B build -DCMAKE_BUILD_TYPE=RelWithDebInfo >/dev/null
+cmake -S . -B build -DCMAKE_BUILD_TYPE=RelWithDebInfo -DFIBRE_BUILD_FIX=ON -DFIBRE_BUILD_TESTS=ON \
+  -DFIBRE_BUILD_BENCH=ON -DFIBRE_SANITIZE=OFF >/dev/null
 cmake --build build -j"$jobs"
 cmake --build build --target bench -j"$jobs"
 (cd build && ctest --output-on-failure -j"$jobs")

@@ -280,6 +280,7 @@ ContactSystem prepare_system(const ContactSystem &read, double scale)
   for (Contact &c : contacts)
     for (double &eps : c.compliance) eps *= scale;
   ContactSystem sys(read.bodies(), std::move(contacts), read.rows(), read.params());
+  if (!sys.sigma().allFinite()) throw std::invalid_argument("Sigma is not finite");
   if (!read.row_mask().empty()) sys.set_row_mask(read.row_mask());
   sys.set_rhs(read.rhs());
   return sys;
@@ -294,7 +295,12 @@ ContactSystem load_system(const Options &opt, int &ghosts)
     throw InputError(e.what());
   }
   ghosts = read.num_bodies() - read.num_owned_bodies();
-  return prepare_system(read, opt.sigma_scale);
+  try {
+    return prepare_system(read, opt.sigma_scale);
+  } catch (const std::invalid_argument &e) {
+    // e.g. a compliance that the scale takes to 0 or to infinity
+    throw InputError("--sigma-scale " + format("%g", opt.sigma_scale) + ": " + e.what());
+  }
 }
 
 bool uniform_sigma(const ContactSystem &sys)
@@ -629,11 +635,11 @@ void print_kappa_table(const std::vector<SpectrumRun> &runs)
   std::printf("   dense: all eigenvalues; body-space: the exact spectrum of A through "
               "M^-1/2 G^T G M^-1/2 (uniform Sigma); lanczos: Ritz values\n"
               "   (lambda_1 and lambda_r converged, the count above the gap unknown: '-')\n");
-  std::printf("  %-8s %-7s %6s %11s %11s %11s %11s %9s %9s  %-26s %7s\n", "form", "precond", "n",
+  std::printf("  %-8s %-7s %6s %11s %11s %11s %11s %9s %9s  %-34s %7s\n", "form", "precond", "n",
               "kappa_e", "kappa", "lambda_1", "lambda_r", "above_gap", "gap", "method", "s");
   for (const SpectrumRun &r : runs) {
     const std::string above = r.complete ? std::to_string(r.s.r + 1) : "-";
-    std::printf("  %-8s %-7s %6ld %11.4g %11.4g %11.4g %11.4g %9s %9.3g  %-26s %7.2f\n",
+    std::printf("  %-8s %-7s %6ld %11.4g %11.4g %11.4g %11.4g %9s %9.3g  %-34s %7.2f\n",
                 to_string(r.form), to_string(r.kind), long(r.n), r.s.kappa_e, r.s.kappa,
                 r.s.lambda_max, r.s.lambda_r, above.c_str(), r.s.gap_ratio, r.method.c_str(),
                 r.seconds);

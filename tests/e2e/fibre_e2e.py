@@ -76,6 +76,7 @@ def run_lmp(args, deck, name, np=1, variables=None, timeout=600):
     env.setdefault("OMPI_ALLOW_RUN_AS_ROOT_CONFIRM", "1")
     env.setdefault("OMPI_MCA_rmaps_base_oversubscribe", "1")
     env.setdefault("OMP_NUM_THREADS", "1")
+    env.setdefault("OMPI_MCA_mpi_yield_when_idle", "1")  # more ranks than cores
     if os.path.exists(log_path):
         os.remove(log_path)
     t0 = time.time()

@@ -9,6 +9,8 @@
   to round-off.
 - A row of four touching spheres hit by a fifth (redundant contacts at once): momentum
   conserved, no energy gain.
+- A cluster of 27 touching spheres with random velocities, without and with friction (also
+  with MUMPS): momentum conserved, no energy gain.
 - A sphere dropped onto a floor: total energy (kinetic + rotational + potential, the
   potential taken at the midpoint z + dt vz / 2 of the next drift, which the scheme conserves
   exactly in free fall) never grows, the overlap stays below v_impact dt and decays, the
@@ -156,6 +158,22 @@ def row_hit(args, ck, opts, tag):
              "max overlap %.4g" % max(r["f_fc[7]"] for r in rows))
 
 
+def cluster(args, ck, opts, tag):
+    """27 touching spheres (3 x 3 x 3), random velocities, no gravity: many redundant contacts
+    at once, with friction."""
+    lines = header() + [
+        "lattice sc 1.0",
+        "region fill block 0 2 0 2 0 2",
+        "create_atoms 1 region fill",
+        "set group all diameter 1.0 density 1.0",
+        "velocity all create 0.01 4928 loop geom",
+    ] + pair_and_fix(opts) + momentum_thermo() + ["run 50"]
+    run = e2e.run_lmp(args, "\n".join(lines) + "\n", "collision_cluster_" + tag)
+    if not ck.ran(run, "cluster %s: run completes" % tag):
+        return
+    check_conservation(ck, "cluster " + tag, run, 0.5)
+
+
 def drop(args, ck, opts, tag):
     z0, g = 3.0, 1.0
     lines = header("-5 5 -5 5 0 10") + [
@@ -202,6 +220,9 @@ def main():
         oblique(args, ck, opts, tag)
         row_hit(args, ck, opts, tag)
         drop(args, ck, opts, tag)
+    for tag, opts in [("frictionless", "mu 0"), ("friction", "mu 0.5"),
+                      ("friction_direct", "mu 0.5 solver direct")]:
+        cluster(args, ck, opts, tag)
     ck.close()
 
 

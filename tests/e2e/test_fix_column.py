@@ -11,7 +11,9 @@ for 1000 steps with every solver and both forms. Checks:
 - the normal impulse of every contact equals dt * g * (mass above it): relative error below
   1e-9 with MUMPS, 1e-5 in contact form and 1e-3 in body form at the default tol 1e-6 (read
   from the fix's per-contact local output through dump local);
-- the fix's global vector: 6 contacts, 1 wall contact, converged.
+- the fix's global vector: 6 contacts, 1 wall contact, converged, and the deepest overlap
+  (f_fc[7]) equals eps_n times the column's weight;
+- 'export' writes the contact system (system_io format) and the same impulses.
 """
 
 import math
@@ -77,7 +79,7 @@ def main():
         ("cr_contact", "form contact solver cr", 1e-5, 1e-10, 1e-9),
         ("minres_body", "form body solver minres", 1e-3, 1e-10, 5e-7),
         ("uzawa_contact", "form contact solver uzawa", 1e-5, 1e-10, 1e-9),
-        ("direct", "solver direct", 1e-9, 1e-20, 1e-12),
+        ("direct", "solver direct export 500 col_export", 1e-9, 1e-20, 1e-12),
         ("fibre_rows3", "form body precond fibre rows 3", 1e-3, 1e-10, 5e-7),
         ("tree_contact", "form contact precond tree", 1e-5, 1e-10, 1e-9),
     ]
@@ -123,6 +125,21 @@ def main():
                  and run.last("f_fc[10]") == 1, "%s: f_fc[3] contacts, f_fc[11] wall "
                  "contacts, f_fc[10] converged" % tag,
                  "%g %g %g" % (run.last("f_fc[3]"), run.last("f_fc[11]"), run.last("f_fc[10]")))
+        if "export" in opts:
+            # the exported system and solution of the last step (one process: rank 0)
+            base = os.path.join(args.workdir, "col_export.%d.0" % STEPS)
+            with open(base + ".sys") as f:
+                sys_lines = f.read().split("\n")
+            with open(base + ".lambda") as f:
+                lam = [line.split() for line in f if not line.startswith("#")]
+            ncont = [int(line.split()[1]) for line in sys_lines if line.startswith("contacts")]
+            exported = {(int(w[1]), int(w[2])): float(w[4]) for w in lam}
+            err = max(e2e.rel_err(exported[(int(r[0]), int(r[1]))], r[4]) for r in contacts)
+            ck.check(sys_lines[0] == "fibre_contact_system 1" and ncont == [len(contacts)]
+                     and len(lam) == len(contacts) and err < 1e-12,
+                     "%s: export writes the system and the same impulses" % tag,
+                     "header '%s', %s contacts, %d impulse lines, max rel diff %.2g"
+                     % (sys_lines[0], ncont, len(lam), err))
         overlap = run.last("f_fc[7]")
         floor = eps * GRAVITY * sum(masses)  # the floor contact carries everything
         ck.check(e2e.rel_err(overlap, floor) < 1e-2, "%s: f_fc[7] = deepest overlap = eps_n "

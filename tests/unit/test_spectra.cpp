@@ -103,6 +103,14 @@ Eigen::MatrixXd random_orthogonal(int n, std::mt19937 &rng)
   return Eigen::HouseholderQR<Eigen::MatrixXd>(X).householderQ();
 }
 
+// The pile for the Lanczos-against-dense checks. Sanitizer builds (-O1, instrumented Eigen)
+// check memory safety, not numerics, and would take many minutes at this size.
+#if defined(__SANITIZE_ADDRESS__)
+constexpr int kPile = 60;
+#else
+constexpr int kPile = 200;
+#endif
+
 // The design's t = 1e-8: the compliance that makes Sigma = 1e-8 for the default SPOOK step.
 SceneParams design_sigma_params()
 {
@@ -233,7 +241,7 @@ TEST(Spectra, LanczosFindsAClearGapLongBeforeN)
 TEST(Spectra, LanczosMatchesDenseOnPilesBothForms)
 {
   // Sigma = 1e-8 as in design.md section 7: null(G^T) sits far below the range of G.
-  const ContactSystem sys = pile_scene(200, design_sigma_params());
+  const ContactSystem sys = pile_scene(kPile, design_sigma_params());
   for (Form form : {Form::contact, Form::body}) {
     const auto op = make_operator(form, sys, serial_exchange());
     for (const char *kind : {"none", "jacobi", "block"}) {
@@ -253,7 +261,7 @@ TEST(Spectra, LanczosMatchesDenseOnPilesBothForms)
 TEST(Spectra, LanczosMatchesDenseForTheLibraryPreconditioners)
 {
   // fibre and tree come from make_preconditioner (preconditioners.cpp).
-  const ContactSystem sys = pile_scene(200, design_sigma_params());
+  const ContactSystem sys = pile_scene(kPile, design_sigma_params());
   for (Form form : {Form::contact, Form::body})
     for (PrecondKind kind : {PrecondKind::block, PrecondKind::fibre, PrecondKind::tree}) {
       PrecondOptions opt;
