@@ -1,6 +1,7 @@
 """Acceptance 4 and 5: pouring about 500 spheres into a box, serially and with MPI.
 
-468 polydisperse spheres (diameters 0.8 to 1.2, density 1) start on a loose lattice up to
+468 polydisperse spheres (diameters 0.8 to 1.2 set from the atom ID, so that every
+process count builds the same scene; density 1) start on a loose lattice up to
 z = 18 above a zplane floor in a periodic 9 x 9 box and fall under gravity g = 1 with the
 fix's defaults (mu 0.5, compliance auto, contact form, CR, block preconditioner),
 dt = 0.01 for 1200 steps.
@@ -42,7 +43,7 @@ neigh_modify delay 0
 lattice sc 0.512 origin 0.5 0.5 0.5
 region fill block -3.2 3.2 -3.2 3.2 1.0 18.0 units box
 create_atoms 1 region fill
-variable d atom 0.8+0.4*random(0,1,4417)
+variable d atom 0.8+0.4*(id*0.6180339887-floor(id*0.6180339887))
 set group all diameter v_d density 1.0
 velocity all create 0.1 5575 loop geom
 """

@@ -48,7 +48,7 @@ Row measure(Form form, PrecondKind kind, const ContactSystem &sys)
   const auto t0 = std::chrono::steady_clock::now();
   const auto P = make_preconditioner(form, sys, serial_exchange(), opt);
   LanczosOptions lo;
-  lo.max_steps = 250;  // beyond this the dense path is cheaper here
+  lo.max_steps = 150;  // beyond this the dense path is cheaper here
   Row row{kind, lanczos_spectrum(form, sys, serial_exchange(), *P, lo), "", 0};
   if (row.s.converged) {
     row.method = "lanczos " + std::to_string(row.s.iterations);
