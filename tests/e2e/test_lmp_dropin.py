@@ -54,4 +54,40 @@ checks.check("mpirun -np 2 runs", rc == 0 and len(t2) == 2, f"exit {rc}")
 if len(t2) == 2 and len(tf) == 2:
     checks.check("mpirun -np 2 inserts the same atoms",
                  [r[1] for r in t2[0][1]] == [r[1] for r in tf[0][1]])
+# mpirun -np 2 on a deck that uses fix fibre_contact: 80 spheres dropped onto a floor.
+fibre_deck = """
+units si
+atom_style sphere
+boundary p p fm
+newton off
+comm_modify vel yes
+lattice sc 1.0
+region box block 0 4 0 4 0 12 units box
+create_box 1 box
+region drop block 0 4 0 4 2 6 units box
+create_atoms 1 region drop
+set group all diameter 0.9
+set group all density 1.0
+velocity all create 1.0 4928 loop geom
+pair_style granular
+pair_coeff * * hertz/material 1e5 0.2 0.3 tangential linear_nohistory 1.0 0.5
+neighbor 0.3 bin
+fix g all gravity 9.81 vector 0 0 -1
+fix fc all fibre_contact mu 0.5 wall zplane 0.0 NULL
+timestep 0.005
+compute ke all ke
+thermo_style custom step atoms c_ke f_fc[1] f_fc[3]
+thermo 50
+run 300
+"""
+for np in (1, 2):
+    rc, out = run(lmp_cmd(args, "in.fibre_np%d" % np, np=np), wd, fibre_deck, "in.fibre_np%d" % np)
+    t = thermo_blocks(out)
+    ok = rc == 0 and len(t) == 1 and len(t[0][1]) == 7
+    checks.check("fix fibre_contact runs with %d rank(s)" % np, ok, f"exit {rc}")
+    if ok:
+        last = t[0][1][-1]
+        checks.check("np %d: all 80 atoms kept, finite, contacts found" % np,
+                     last[1] == 80 and all(abs(v) < 1e30 for v in last) and last[4] > 0,
+                     str(last))
 checks.finish()
