@@ -11,13 +11,11 @@
 
 #include <algorithm>
 #include <cerrno>
-#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
 #include <exception>
-#include <numeric>
 
 #include "atom.h"
 #include "comm.h"
@@ -35,7 +33,6 @@
 #include "region.h"
 #include "update.h"
 #include "utils.h"
-
 
 using namespace LAMMPS_NS;
 using namespace FixConst;
@@ -773,7 +770,6 @@ void FixFibreContact::fill_local_output(const std::vector<Found> &found,
     memory->create(local_array_, maxlocal_, kLocalColumns, "fibre_contact:local");
   }
   array_local = local_array_;
-  nlocal_rows_ = nc;
   size_local_rows = nc;
   for (int c = 0; c < nc; ++c) {
     const Found &fc = found[c];

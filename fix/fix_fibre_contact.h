@@ -135,7 +135,6 @@ class FixFibreContact : public Fix {
   double last_m_min_ = 0.0;
 
   // local output: one row per contact owned by this process
-  int nlocal_rows_ = 0;
   int maxlocal_ = 0;
   double **local_array_ = nullptr;
 };

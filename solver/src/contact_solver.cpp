@@ -256,20 +256,27 @@ Vector StepSolver::linear_solve(const Vector &b, const Vector &warm, StepResult 
 }
 
 // Decides the next active set from the pass's lambda (active rows solved, capped rows fixed).
-// Rows outside the solve are judged by their trial impulse lambda + rho / sigma, rho the row's
-// residual of the full system (the regularized row equation solved for that row alone): it
+// Rows outside the solve are judged by their trial impulse lambda + rho / A_ii, rho the row's
+// residual of the full system (the row equation solved for that row alone): it
 // re-activates released contacts that would press again and un-caps cones that would stick.
-// A capped cone keeps the slip direction it was capped with: following the newest direction
-// makes the caps oscillate (measured on random-velocity piles), the magnitude follows l_n.
+// A capped cone takes its direction from the newest trial impulse, i.e. against the slip the
+// pass left, so that friction dissipates; the magnitude follows l_n.
 // Returns the number of local changes wanted (a reversal over budget counts but is not done).
 int StepSolver::update_set(const Vector &lambda, const std::vector<unsigned char> &mask)
 {
   Vector G_dv;
   g_apply(sys_, velocity_change(lambda), G_dv);
   const Vector rho = b_full_ - G_dv - sys_.sigma().cwiseProduct(lambda);
+  // One Gauss-Seidel step per row outside the solve: lambda + rho / A_ii. Dividing by Sigma
+  // alone (tiny) would only see the sign of rho and never find a cone's interior.
   Vector value = lambda;
-  for (Eigen::Index row = 0; row < value.size(); ++row)
-    if (!mask[row]) value[row] += rho[row] / sys_.sigma()[row];
+  for (int c = 0; c < nc_; ++c) {
+    const Mat6 D = diagonal_block(sys_, c);
+    for (int r = 0; r < rows_; ++r) {
+      const Eigen::Index row = base(c) + r;
+      if (!mask[row]) value[row] += rho[row] / D(r, r);
+    }
+  }
 
   int changes = 0;
   for (int c = 0; c < nc_; ++c) {
@@ -295,7 +302,7 @@ int StepSolver::update_set(const Vector &lambda, const std::vector<unsigned char
       const Eigen::Vector2d t = cone_values(value, base(c), kCones[k]);
       const double tn = t.norm();
       if (tn > radius) {
-        if (!st.capped[k]) st.dir[k] = t / tn;  // the solved slip direction
+        st.dir[k] = t / tn;  // against the slip the pass left
         changes += !st.capped[k];
         st.capped[k] = true;
       } else if (st.capped[k] && tn < radius * (1 - 1e-9)) {

@@ -2,8 +2,11 @@
 
 Every keyword with a missing or invalid value, an unknown keyword, a wrong atom style, no
 pair style, a pair style without a usable neighbor list, an unknown or moving region, pair
-forces switched back on, and a 2d box. Each case checks the exit status and that the ERROR
-line names the problem (the keyword and the expected form).
+forces switched back on, a 2d box, and an infinite force (an error naming the atom and the
+step). Each case checks the exit status and that the ERROR
+line names the problem (the keyword and the expected form). Two runs that complete check
+the log messages: another fix integrating the same atoms (a warning), and the pair style's
+forces switched off.
 """
 
 import fibre_e2e as e2e
@@ -95,6 +98,17 @@ CASES = [
      {"pre": "variable vz equal 0.1*time\n"
              "region cup cylinder z 0 0 2.5 0 5 side in move NULL NULL v_vz units box"}),
     ("two_d", "", "requires a 3d simulation", {"deck": TWO_D}),
+    ("infinite_force", "", "non-finite force of atom 1 at step 1",
+     {"pre": "fix push all addforce 0 0 1e400"}),
+]
+
+
+# (name, fix arguments, expected text in a WARNING line, deck overrides): runs that complete
+WARN_CASES = [
+    ("double_integration", "", "Fix fibre_contact: fix nve (nve/sphere) also time-integrates 1 "
+     "atoms of group all", {"pre": "fix nve all nve/sphere"}),
+    ("pair_switched_off", "", "switched off the force computation of pair style gran/hooke",
+     {}),
 ]
 
 
@@ -112,6 +126,14 @@ def main():
         ck.check(run.rc != 0 and expected in err and "ERROR" in err,
                  "%s: '%s' fails" % (name, fix_args) if fix_args else "%s fails" % name,
                  "rc %d, %s" % (run.rc, err if err else "no ERROR line"))
+    for name, fix_args, expected, over in WARN_CASES:
+        fields = {"style": "sphere", "set": "set atom 1 diameter 1.0 density 1.0",
+                  "pair": GRAN, "pre": "", "post": "", "args": fix_args}
+        fields.update(over)
+        run = e2e.run_lmp(args, BASE.format(**fields), "warn_" + name, timeout=120)
+        lines = [line.strip() for line in run.output.splitlines() if expected in line]
+        ck.check(run.rc == 0 and bool(lines), "%s: runs and says so" % name,
+                 "rc %d, %s" % (run.rc, lines[0] if lines else "message missing"))
     ck.close()
 
 
