@@ -1,61 +1,58 @@
 """lmp_fibre is a drop-in replacement for Debian's lmp (issue 2 acceptance):
 - a shortened official pour deck gives the same thermo output as lmp;
 - the startup banner names the add-on;
-- an unknown fix style exits non-zero with a LAMMPS error;
-- it runs under mpirun -np 2.
+- an unknown fix style, and a bad fibre_contact argument, exit non-zero with a LAMMPS error;
+- it runs under mpirun -np 2, the stock deck and a deck with fix fibre_contact.
 """
 import os
 import re
 import shutil
+import subprocess
 
-from e2e_common import Checks, lmp_cmd, parse_args, run, thermo_blocks
+import fibre_e2e as e2e
 
-args = parse_args()
-checks = Checks()
-wd = args.workdir
+args = e2e.parse_args()
+ck = e2e.Checks("lmp_fibre as a drop-in lmp")
 
-# The official pour deck, shortened to 2000 steps with thermo every 200.
-official = "/usr/share/lammps/examples/pour/in.pour"
-deck = open(official).read()
+# The official pour deck, shortened to 2 x 1000 steps with thermo every 200.
+deck = open("/usr/share/lammps/examples/pour/in.pour").read()
 deck = re.sub(r"thermo\s+1000", "thermo 200", deck)
-deck = deck.replace("run\t\t25000\n\nunfix", "run 1000\n\nunfix").replace("run\t\t25000", "run 1000")
+deck = re.sub(r"run\s+25000", "run 1000", deck)
 assert deck.count("run 1000") == 2, "pour deck layout changed"
-with open(os.path.join(wd, "in.pour"), "w") as f:
-    f.write(deck)
 
-rc_f, out_f = run(lmp_cmd(args, "in.pour"), wd)
+fibre = e2e.run_lmp(args, deck, "pour")
+ck.ran(fibre, "pour runs with lmp_fibre")
 lmp = shutil.which("lmp") or "/usr/bin/lmp"
-rc_l, out_l = run([lmp, "-in", "in.pour", "-log", "log.lmp"], wd)
-checks.check("pour runs with lmp_fibre", rc_f == 0, f"exit {rc_f}")
-checks.check("pour runs with lmp", rc_l == 0, f"exit {rc_l}")
-tf, tl = thermo_blocks(out_f), thermo_blocks(out_l)
-checks.check("same thermo tables", len(tf) == 2 and tf == tl,
-             f"{len(tf)} blocks, last rows {tf[-1][1][-1] if tf else None} vs "
-             f"{tl[-1][1][-1] if tl else None}")
-checks.check("banner names the add-on", "fibre_contact add-on" in out_f)
+native = subprocess.run([lmp, "-in", os.path.join(args.workdir, "in.pour"), "-log", "none"],
+                        cwd=args.workdir, stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
+                        text=True, timeout=600)
+ck.check(native.returncode == 0, "pour runs with lmp", "rc %d" % native.returncode)
+reference = e2e.parse_thermo(native.stdout)
+ck.check(len(fibre.thermo) == 2 and fibre.thermo == reference, "same thermo tables",
+         "%d blocks, last rows %s vs %s" % (len(fibre.thermo),
+                                            fibre.thermo[-1][-1] if fibre.thermo else None,
+                                            reference[-1][-1] if reference else None))
+ck.check("fibre_contact add-on" in fibre.output, "banner names the add-on")
 
-# Unknown style: a LAMMPS error and a non-zero exit.
-bad = "units lj\natom_style sphere\nregion b block 0 1 0 1 0 1\ncreate_box 1 b\nfix 1 all no_such_fix\n"
-rc, out = run(lmp_cmd(args, "in.bad"), wd, bad, "in.bad")
-checks.check("unknown fix exits non-zero", rc != 0, f"exit {rc}")
-checks.check("unknown fix message", "ERROR" in out and "no_such_fix" in out)
+# Unknown style, and a bad fibre_contact argument: a LAMMPS error and a non-zero exit.
+box = "units lj\natom_style sphere\nregion b block 0 1 0 1 0 1\ncreate_box 1 b\n"
+bad = e2e.run_lmp(args, box + "fix 1 all no_such_fix\n", "unknown_fix")
+ck.check(bad.rc != 0 and "no_such_fix" in bad.error_line(), "unknown fix: error, non-zero exit",
+         "rc %d, %s" % (bad.rc, bad.error_line()))
+bad = e2e.run_lmp(args, box + "pair_style granular\n"
+                  "pair_coeff * * hertz/material 1e5 0.2 0.3 tangential linear_nohistory 1.0 0\n"
+                  "fix 1 all fibre_contact tol -1\n", "bad_tol")
+ck.check(bad.rc != 0 and "tol" in bad.error_line(), "bad fibre_contact argument names 'tol'",
+         "rc %d, %s" % (bad.rc, bad.error_line()))
 
-# Bad argument for fibre_contact.
-bad2 = bad.replace("fix 1 all no_such_fix", "pair_style granular\npair_coeff * * hertz/material 1e5 0.2 0.3 tangential linear_nohistory 1.0 0.0\nfix 1 all fibre_contact tol -1")
-rc, out = run(lmp_cmd(args, "in.bad2"), wd, bad2, "in.bad2")
-checks.check("bad fibre_contact argument exits non-zero", rc != 0, f"exit {rc}")
-checks.check("bad argument message names the keyword", "ERROR" in out and "tol" in out,
-             out.strip().splitlines()[-1] if out.strip() else "")
+# mpirun -np 2 on the stock deck: the same atoms are inserted.
+mpi = e2e.run_lmp(args, deck, "pour_np2", np=2)
+if ck.ran(mpi, "pour runs under mpirun -np 2") and len(fibre.thermo) == 2:
+    ck.check([r["Atoms"] for r in mpi.thermo[0]] == [r["Atoms"] for r in fibre.thermo[0]],
+             "mpirun -np 2 inserts the same atoms")
 
-# mpirun -np 2 on the stock deck: same atom counts as serial.
-rc, out = run(lmp_cmd(args, "in.pour", np=2), wd)
-t2 = thermo_blocks(out)
-checks.check("mpirun -np 2 runs", rc == 0 and len(t2) == 2, f"exit {rc}")
-if len(t2) == 2 and len(tf) == 2:
-    checks.check("mpirun -np 2 inserts the same atoms",
-                 [r[1] for r in t2[0][1]] == [r[1] for r in tf[0][1]])
-# mpirun -np 2 on a deck that uses fix fibre_contact: 80 spheres dropped onto a floor.
-fibre_deck = """
+# A deck with fix fibre_contact, serial and mpirun -np 2: 80 spheres dropped onto a floor.
+FIBRE_DECK = """
 units si
 atom_style sphere
 boundary p p fm
@@ -81,13 +78,10 @@ thermo 50
 run 300
 """
 for np in (1, 2):
-    rc, out = run(lmp_cmd(args, "in.fibre_np%d" % np, np=np), wd, fibre_deck, "in.fibre_np%d" % np)
-    t = thermo_blocks(out)
-    ok = rc == 0 and len(t) == 1 and len(t[0][1]) == 7
-    checks.check("fix fibre_contact runs with %d rank(s)" % np, ok, f"exit {rc}")
-    if ok:
-        last = t[0][1][-1]
-        checks.check("np %d: all 80 atoms kept, finite, contacts found" % np,
-                     last[1] == 80 and all(abs(v) < 1e30 for v in last) and last[4] > 0,
-                     str(last))
-checks.finish()
+    run = e2e.run_lmp(args, FIBRE_DECK, "fibre_np%d" % np, np=np)
+    if ck.ran(run, "fix fibre_contact runs with %d rank(s)" % np) and run.thermo:
+        last = run.thermo[-1][-1]
+        ck.check(last["Atoms"] == 80 and all(abs(v) < 1e30 for v in last.values()) and
+                 last["f_fc[3]"] > 0, "np %d: all 80 atoms kept, finite, contacts found" % np,
+                 str(last))
+ck.close()
