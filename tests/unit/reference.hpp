@@ -3,12 +3,20 @@
 #pragma once
 
 #include <Eigen/Dense>
+#include <algorithm>
 
 #include "fibre/system.hpp"
 
 namespace fibre::test {
 
 using Dense = Eigen::MatrixXd;
+
+// ||a - b|| / ||b|| (Frobenius for matrices), safe for b = 0.
+template <typename A, typename B>
+double rel_diff(const Eigen::MatrixBase<A> &a, const Eigen::MatrixBase<B> &b)
+{
+  return (a - b).norm() / std::max(b.norm(), 1e-300);
+}
 
 // Dense G: rows() per contact, 6 per body (masked rows zero).
 inline Dense dense_G(const ContactSystem &sys)

@@ -10,10 +10,7 @@ using namespace fibre;
 
 namespace {
 
-double rel_diff(const Eigen::MatrixXd &a, const Eigen::MatrixXd &b)
-{
-  return (a - b).norm() / std::max(b.norm(), 1e-300);
-}
+using fibre::test::rel_diff;
 
 void expect_assembly_matches_dense(const ContactSystem &sys)
 {

@@ -8,10 +8,13 @@
 #include "fibre/contact_solver.hpp"
 #include "fibre/kernels.hpp"
 #include "fibre/scenes.hpp"
+#include "reference.hpp"
 
 using namespace fibre;
 
 namespace {
+
+using fibre::test::rel_diff;
 
 constexpr double kG = 9.81;
 constexpr double kH = 1e-3;
@@ -68,11 +71,6 @@ std::string label(const StepOptions &o)
 StepResult solve(ContactSystem &sys, const StepOptions &o, const Vector *warm = nullptr)
 {
   return solve_step(sys, serial_exchange(), o, warm, MPI_COMM_SELF);
-}
-
-double rel_diff(const Vector &a, const Vector &b)
-{
-  return (a - b).norm() / std::max(b.norm(), 1e-300);
 }
 
 }  // namespace

@@ -23,10 +23,7 @@ using namespace fibre;
 
 namespace {
 
-double rel_diff(const Eigen::VectorXd &a, const Eigen::VectorXd &b)
-{
-  return (a - b).norm() / std::max(b.norm(), 1e-300);
-}
+using fibre::test::rel_diff;
 
 int world_size()
 {

@@ -15,15 +15,12 @@ using namespace fibre;
 
 namespace {
 
+using fibre::test::rel_diff;
+
 const Method kMethods[] = {Method::uzawa, Method::cr, Method::minres};
 const PrecondKind kPreconds[] = {PrecondKind::none, PrecondKind::jacobi, PrecondKind::block,
                                  PrecondKind::fibre, PrecondKind::tree};
 const Form kForms[] = {Form::contact, Form::body};
-
-double rel_diff(const Vector &a, const Vector &b)
-{
-  return (a - b).norm() / std::max(b.norm(), 1e-300);
-}
 
 // The dense reference of one system: lambda* = A^-1 b and dv* = M^-1 G^T lambda*, and the
 // body form's own dense solution K^-1 G^T Sigma^-1 b.

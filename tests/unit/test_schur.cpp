@@ -10,10 +10,7 @@ using namespace fibre;
 
 namespace {
 
-double rel_diff(const Eigen::VectorXd &a, const Eigen::VectorXd &b)
-{
-  return (a - b).norm() / std::max(b.norm(), 1e-300);
-}
+using fibre::test::rel_diff;
 
 void expect_schur_matches_dense(const ContactSystem &sys)
 {
