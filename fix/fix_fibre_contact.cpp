@@ -105,9 +105,10 @@ FixFibreContact::FixFibreContact(LAMMPS *lmp, int narg, char **arg) : Fix(lmp, n
   comm_reverse = fibre_lmp::LammpsExchange::kValuesPerAtom;
   maxexchange = 1 + kMaxSlots * kSlotSize;
 
-  opt_.form = fibre::Form::contact;
-  opt_.solver = fibre::SolverKind::cr;
-  opt_.precond.kind = fibre::PrecondKind::block;
+  // defaults by measurement (doc/fix_fibre_contact.md, "Solvers")
+  opt_.form = fibre::Form::body;
+  opt_.solver = fibre::SolverKind::uzawa;
+  opt_.precond.kind = fibre::PrecondKind::tree;
   opt_.precond.weight = fibre::EdgeWeight::z;
   opt_.stop.tol = 1e-6;
   opt_.stop.max_iter = 200;
