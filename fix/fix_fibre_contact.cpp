@@ -44,13 +44,6 @@ constexpr int kWallKeyStride = 1024;  // wall key = wall index * stride + sub-wa
 constexpr double kRestartFormat = 1.0;
 // pairs closer than this fraction of the smaller radius are always contacts
 constexpr double kContactMargin = 0.01;
-// The warm start of the friction, rolling and twisting rows is scaled by this factor so that
-// it lies strictly inside its cone. Workaround: fibre::solve_step pre-caps cones whose warm
-// impulse is on the boundary and its active-set test for capped rows (trial impulse
-// lambda + rho / sigma) then never un-caps them, so a sliding contact never sticks again (a
-// sliding sphere accelerates backwards through v = 0). Starting inside the cone, the first
-// pass solves the cone as sticking and caps it only if the solve leaves the cone.
-constexpr double kWarmConeShrink = 1.0 - 1e-6;
 
 bool to_double(const char *s, double &value)
 {
@@ -210,6 +203,12 @@ void FixFibreContact::parse_args(int narg, char **arg)
       if (!(v > 0.0)) illegal(e, val);
       opt_.stop.tol = v;
       iarg += 2;
+    } else if (key == "pass_tol") {
+      const std::string e = "'pass_tol <positive number>'";
+      const double v = parse_number(narg, arg, iarg + 1, e);
+      if (!(v > 0.0)) illegal(e, val);
+      opt_.pass_tol = v;
+      iarg += 2;
     } else if (key == "maxiter") {
       const std::string e = "'maxiter <positive integer>'";
       long v = 0;
@@ -303,8 +302,8 @@ void FixFibreContact::parse_args(int narg, char **arg)
       export_prefix_ = arg[iarg + 2];
       iarg += 3;
     } else {
-      illegal("a keyword (form, solver, precond, weight, tol, maxiter, compliance, damping, mu, "
-              "mu_roll, mu_twist, rows, active_set, wall, export)",
+      illegal("a keyword (form, solver, precond, weight, tol, pass_tol, maxiter, compliance, "
+              "damping, mu, mu_roll, mu_twist, rows, active_set, wall, export)",
               arg[iarg]);
     }
   }
@@ -373,8 +372,9 @@ void FixFibreContact::init()
                       ", solver " + fibre::to_string(opt_.solver) + ", precond " +
                       fibre::to_string(opt_.precond.kind) + ", weight " +
                       fibre::to_string(opt_.precond.weight) + ", tol " + fmt_g(opt_.stop.tol) +
-                      ", maxiter " + std::to_string(opt_.stop.max_iter) + ", rows " +
-                      std::to_string(rows_) + ", damping " + fmt_g(damping_) + ", mu " +
+                      ", pass_tol " + fmt_g(opt_.pass_tol) + ", maxiter " +
+                      std::to_string(opt_.stop.max_iter) + ", rows " + std::to_string(rows_) +
+                      ", damping " + fmt_g(damping_) + ", mu " +
                       fmt_g(opt_.friction.mu) + ", mu_roll " + fmt_g(opt_.friction.mu_roll) +
                       ", mu_twist " + fmt_g(opt_.friction.mu_twist) + ", active_set " +
                       std::to_string(opt_.active_set_max) + ", compliance ";
@@ -697,11 +697,8 @@ void FixFibreContact::warm_start(const std::vector<Found> &found, int rows,
     const fibre::Contact &k = fc.contact;
     const fibre::Vec3 dirs[3] = {k.normal, k.t1, k.t2};
     for (int r = 0; r < rows; ++r) {
-      // Friction, rolling and twisting rows start strictly inside their cone (see
-      // kWarmConeShrink); the normal row keeps last step's value.
-      const double shrink = r == 0 ? 1.0 : kWarmConeShrink;
       warm[Eigen::Index(rows) * c + r] =
-          shrink * dtv_ * (r < 3 ? force.dot(dirs[r]) : moment.dot(dirs[r - 3]));
+          dtv_ * (r < 3 ? force.dot(dirs[r]) : moment.dot(dirs[r - 3]));
     }
   }
 }

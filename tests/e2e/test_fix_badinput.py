@@ -53,6 +53,8 @@ CASES = [
     ("tol_negative", "tol -1e-6", "expected 'tol <positive number>', got '-1e-6'", {}),
     ("tol_text", "tol small", "expected 'tol <positive number>', got 'small'", {}),
     ("tol_missing", "mu 0.3 tol", "expected 'tol <positive number>'", {}),
+    ("pass_tol_zero", "pass_tol 0", "expected 'pass_tol <positive number>'", {}),
+    ("pass_tol_missing", "pass_tol", "expected 'pass_tol <positive number>'", {}),
     ("maxiter_zero", "maxiter 0", "expected 'maxiter <positive integer>', got '0'", {}),
     ("maxiter_real", "maxiter 2.5", "expected 'maxiter <positive integer>', got '2.5'", {}),
     ("compliance_one", "compliance 1e-6", "expected 'compliance auto' or 'compliance <eps_n> "
