@@ -34,27 +34,30 @@ ContactGraph contact_graph(const ContactSystem &sys, bool include_ghosts)
 {
   const int nb = sys.num_bodies(), nc = sys.num_contacts();
   const int limit = include_ghosts ? nb : sys.num_owned_bodies();
-  const std::vector<Contact> &contacts = sys.contacts();
-  auto is_edge = [&](const Contact &k) { return !k.is_wall() && k.a < limit && k.b < limit; };
+  // The flat body pairs (8 bytes a contact) instead of the Contact records (160 bytes).
+  const int *pairs = sys.body_pairs();
+  auto is_edge = [&](int a, int b) { return b >= 0 && a < limit && b < limit; };
   ContactGraph g;
   g.start.assign(std::size_t(nb) + 1, 0);
-  for (const Contact &k : contacts)
-    if (is_edge(k)) {
-      ++g.start[k.a + 1];
-      ++g.start[k.b + 1];
+  for (int c = 0; c < nc; ++c) {
+    const int a = pairs[2 * std::size_t(c)], b = pairs[2 * std::size_t(c) + 1];
+    if (is_edge(a, b)) {
+      ++g.start[a + 1];
+      ++g.start[b + 1];
       ++g.num_edges;
     }
+  }
   for (int i = 0; i < nb; ++i) g.start[i + 1] += g.start[i];
   g.neighbour.resize(std::size_t(2) * g.num_edges);
   g.contact.resize(std::size_t(2) * g.num_edges);
   std::vector<int> fill(g.start.begin(), g.start.end() - 1);
   for (int c = 0; c < nc; ++c) {
-    const Contact &k = contacts[c];
-    if (!is_edge(k)) continue;
-    g.neighbour[fill[k.a]] = k.b;
-    g.contact[fill[k.a]++] = c;
-    g.neighbour[fill[k.b]] = k.a;
-    g.contact[fill[k.b]++] = c;
+    const int a = pairs[2 * std::size_t(c)], b = pairs[2 * std::size_t(c) + 1];
+    if (!is_edge(a, b)) continue;
+    g.neighbour[fill[a]] = b;
+    g.contact[fill[a]++] = c;
+    g.neighbour[fill[b]] = a;
+    g.contact[fill[b]++] = c;
   }
   return g;
 }
@@ -281,28 +284,35 @@ Forest build_forest(const ContactSystem &sys, EdgeWeight weight, const Vector *i
   const int nb = sys.num_bodies(), nc = sys.num_contacts();
   const int limit = include_ghosts ? nb : sys.num_owned_bodies();
 
+  const int *pairs = sys.body_pairs();
   std::vector<char> in_tree(nc, 0);
   DisjointSets sets(nb);
   for (int c : fibres.contacts) {
     in_tree[c] = 1;
-    sets.join(sys.contacts()[c].a, sys.contacts()[c].b);
+    sets.join(pairs[2 * std::size_t(c)], pairs[2 * std::size_t(c) + 1]);
   }
-  std::vector<std::pair<double, int>> rest;
+  // The remaining edges in contact order (a sequential pass), then sorted by (weight, contact).
+  struct Edge {
+    double w;
+    int c, a, b;
+    bool operator<(const Edge &o) const { return w < o.w || (w == o.w && c < o.c); }
+  };
+  std::vector<Edge> rest;
   rest.reserve(std::size_t(g.num_edges) - fibres.contacts.size());
-  for (int i = 0; i < limit; ++i)
-    for (int e = g.start[i]; e < g.start[i + 1]; ++e)
-      if (g.neighbour[e] > i && !in_tree[g.contact[e]])
-        rest.emplace_back(cost.fixed(g.contact[e], i, g.neighbour[e]), g.contact[e]);
+  for (int c = 0; c < nc; ++c) {
+    const int a = pairs[2 * std::size_t(c)], b = pairs[2 * std::size_t(c) + 1];
+    if (b < 0 || a >= limit || b >= limit || in_tree[c]) continue;
+    const int lo = std::min(a, b), hi = std::max(a, b);
+    rest.push_back({cost.fixed(c, lo, hi), c, a, b});
+  }
   std::sort(rest.begin(), rest.end());
   Forest f;
   f.num_edges = static_cast<int>(fibres.contacts.size());
-  for (const auto &[w, c] : rest) {
-    (void)w;
-    if (sets.join(sys.contacts()[c].a, sys.contacts()[c].b)) {
-      in_tree[c] = 1;
+  for (const Edge &e : rest)
+    if (sets.join(e.a, e.b)) {
+      in_tree[e.c] = 1;
       ++f.num_edges;
     }
-  }
 
   // Root every tree at its smallest body and list bodies in DFS post-order.
   f.parent.assign(nb, -1);

@@ -12,56 +12,213 @@ inline void row_weights(const ContactSystem &sys, int c, double *wt)
     wt[r] = (r < sys.rows() && sys.row_active(base + r)) ? 1.0 : 0.0;
 }
 
-// Contact-frame velocity of one side: [D (v + omega x r) ; D omega].
-inline Vec6 side_velocity(const Mat3 &D, const Vec3 &r, const double *w)
+}  // namespace
+
+// ---- The products (the Krylov methods' inner loop) ----
+//
+// One pass per product over the contacts in contact order, reading per contact its 15
+// kinematic numbers (frame D, rows n, t1, t2; levers ra, rb), its two body indices from the
+// flat pair array and its 1/Sigma or Sigma rows; the body vectors are gathered and scattered
+// by body index. Templated on the row count (3: translational rows only) and on whether rows
+// are masked (weights 0/1 multiply the rows), so that the common case carries no branches.
+// G_c w = [D (v_a + omega_a x ra - v_b - omega_b x rb) ; D (omega_a - omega_b)];
+// G_c^T l: f = D^T l_t, m = D^T l_r; a gets (f, ra x f + m), b gets -(f, rb x f + m).
+
+namespace {
+
+// u (R rows) = G_c w for contact c with frame D (column-major 3x3), levers ra, rb.
+#if defined(__GNUC__)
+#define FIBRE_INLINE inline __attribute__((always_inline))
+#else
+#define FIBRE_INLINE inline
+#endif
+
+template <int R>
+FIBRE_INLINE void contact_velocity(const double *D, const double *ra, const double *rb, const double *wa,
+                             const double *wb, double *u)
 {
-  const Eigen::Map<const Vec3> v(w), omega(w + 3);
-  Vec6 u;
-  u.head<3>() = D * (v + omega.cross(r));
-  u.tail<3>() = D * omega;
-  return u;
+  // t = v_a + omega_a x ra (- v_b - omega_b x rb), o = omega_a (- omega_b)
+  double t0 = wa[0] + wa[4] * ra[2] - wa[5] * ra[1];
+  double t1 = wa[1] + wa[5] * ra[0] - wa[3] * ra[2];
+  double t2 = wa[2] + wa[3] * ra[1] - wa[4] * ra[0];
+  double o0 = wa[3], o1 = wa[4], o2 = wa[5];
+  if (wb) {
+    t0 -= wb[0] + wb[4] * rb[2] - wb[5] * rb[1];
+    t1 -= wb[1] + wb[5] * rb[0] - wb[3] * rb[2];
+    t2 -= wb[2] + wb[3] * rb[1] - wb[4] * rb[0];
+    o0 -= wb[3];
+    o1 -= wb[4];
+    o2 -= wb[5];
+  }
+  for (int i = 0; i < 3; ++i) u[i] = D[i] * t0 + D[i + 3] * t1 + D[i + 6] * t2;
+  if (R == 6)
+    for (int i = 0; i < 3; ++i) u[3 + i] = D[i] * o0 + D[i + 3] * o1 + D[i + 6] * o2;
 }
 
-// Generalized force of an impulse l (contact frame) on one side: [f ; r x f + D^T l_rot].
-inline void add_side_impulse(const Mat3 &D, const Vec3 &r, const Vec6 &l, double sign, double *out)
+// Adds G_c^T l into the body vectors ya and (if not a wall) yb.
+template <int R>
+FIBRE_INLINE void contact_impulse(const double *D, const double *ra, const double *rb, const double *l,
+                            double *ya, double *yb)
 {
-  const Vec3 f = sign * (D.transpose() * l.head<3>());
-  const Vec3 tau = r.cross(f) + sign * (D.transpose() * l.tail<3>());
-  Eigen::Map<Vec3>(out) += f;
-  Eigen::Map<Vec3>(out + 3) += tau;
+  double f[3], m[3] = {0, 0, 0};
+  for (int k = 0; k < 3; ++k) f[k] = D[3 * k] * l[0] + D[3 * k + 1] * l[1] + D[3 * k + 2] * l[2];
+  if (R == 6)
+    for (int k = 0; k < 3; ++k)
+      m[k] = D[3 * k] * l[3] + D[3 * k + 1] * l[4] + D[3 * k + 2] * l[5];
+  ya[0] += f[0];
+  ya[1] += f[1];
+  ya[2] += f[2];
+  ya[3] += ra[1] * f[2] - ra[2] * f[1] + m[0];
+  ya[4] += ra[2] * f[0] - ra[0] * f[2] + m[1];
+  ya[5] += ra[0] * f[1] - ra[1] * f[0] + m[2];
+  if (!yb) return;
+  yb[0] -= f[0];
+  yb[1] -= f[1];
+  yb[2] -= f[2];
+  yb[3] -= rb[1] * f[2] - rb[2] * f[1] + m[0];
+  yb[4] -= rb[2] * f[0] - rb[0] * f[2] + m[1];
+  yb[5] -= rb[0] * f[1] - rb[1] * f[0] + m[2];
 }
+
+constexpr int kAhead = 16;  // prefetch distance in contacts
+
+// The bodies are gathered and scattered by index: ask for those of contact c + kAhead now (the
+// contact arrays themselves stream and need no help). rw: 1 when they will be written.
+template <int RW>
+inline void prefetch_bodies(const int *pairs, int c, int nc, const double *v)
+{
+#if defined(__GNUC__)
+  if (c + kAhead >= nc) return;
+  const int pa = pairs[2 * std::size_t(c + kAhead)], pb = pairs[2 * std::size_t(c + kAhead) + 1];
+  __builtin_prefetch(v + 6 * std::size_t(pa), RW);
+  if (pb >= 0) __builtin_prefetch(v + 6 * std::size_t(pb), RW);
+#else
+  (void)pairs;
+  (void)c;
+  (void)nc;
+  (void)v;
+#endif
+}
+
+inline const double *kin_data(const ContactSystem &sys)
+{
+  static_assert(sizeof(ContactKinematics) == 15 * sizeof(double),
+                "ContactKinematics must be 15 packed doubles (frame, ra, rb)");
+  return sys.num_contacts() > 0 ? sys.kinematics(0).frame.data() : nullptr;
+}
+
+// out = G w, plus Sigma x when x is given (the Schur product's diagonal, fused).
+template <int R, bool Masked>
+void g_kernel(const ContactSystem &sys, const double *w, const double *x, double *out)
+{
+  const int nc = sys.num_contacts();
+  const double *kin = kin_data(sys);
+  const int *pairs = sys.body_pairs();
+  const double *wt = Masked ? sys.row_weight().data() : nullptr;
+  const double *sigma = sys.sigma().data();
+  for (int c = 0; c < nc; ++c) {
+    prefetch_bodies<0>(pairs, c, nc, w);
+    const double *q = kin + 15 * std::size_t(c);
+    const int a = pairs[2 * std::size_t(c)], b = pairs[2 * std::size_t(c) + 1];
+    double u[6];
+    contact_velocity<R>(q, q + 9, q + 12, w + 6 * std::size_t(a),
+                        b >= 0 ? w + 6 * std::size_t(b) : nullptr, u);
+    double *o = out + std::size_t(R) * c;
+    for (int r = 0; r < R; ++r) {
+      const std::size_t row = std::size_t(R) * c + r;
+      double v = Masked ? wt[row] * u[r] : u[r];
+      if (x) v += sigma[row] * x[row];
+      o[r] = v;
+    }
+  }
+}
+
+// out += G^T lambda (out zeroed by the caller).
+template <int R, bool Masked>
+void gt_kernel(const ContactSystem &sys, const double *lambda, double *out)
+{
+  const int nc = sys.num_contacts();
+  const double *kin = kin_data(sys);
+  const int *pairs = sys.body_pairs();
+  const double *wt = Masked ? sys.row_weight().data() : nullptr;
+  for (int c = 0; c < nc; ++c) {
+    prefetch_bodies<1>(pairs, c, nc, out);
+    const double *q = kin + 15 * std::size_t(c);
+    const int a = pairs[2 * std::size_t(c)], b = pairs[2 * std::size_t(c) + 1];
+    double l[6] = {0, 0, 0, 0, 0, 0};
+    for (int r = 0; r < R; ++r) {
+      const std::size_t row = std::size_t(R) * c + r;
+      l[r] = Masked ? wt[row] * lambda[row] : lambda[row];
+    }
+    contact_impulse<R>(q, q + 9, q + 12, l, out + 6 * std::size_t(a),
+                       b >= 0 ? out + 6 * std::size_t(b) : nullptr);
+  }
+}
+
+// out += G^T Sigma^-1 G w in one pass (the body product without its intermediate vector).
+template <int R, bool Masked>
+FIBRE_INLINE void gtg_kernel(const ContactSystem &sys, const double *w, double *out)
+{
+  const int nc = sys.num_contacts();
+  const double *kin = kin_data(sys);
+  const int *pairs = sys.body_pairs();
+  const double *wt = Masked ? sys.row_weight().data() : nullptr;
+  const double *inv_sigma = sys.inv_sigma().data();
+  for (int c = 0; c < nc; ++c) {
+    prefetch_bodies<0>(pairs, c, nc, w);
+    prefetch_bodies<1>(pairs, c, nc, out);
+    const double *q = kin + 15 * std::size_t(c);
+    const int a = pairs[2 * std::size_t(c)], b = pairs[2 * std::size_t(c) + 1];
+    const double *wb = b >= 0 ? w + 6 * std::size_t(b) : nullptr;
+    double u[6] = {0, 0, 0, 0, 0, 0};
+    contact_velocity<R>(q, q + 9, q + 12, w + 6 * std::size_t(a), wb, u);
+    for (int r = 0; r < R; ++r) {
+      const std::size_t row = std::size_t(R) * c + r;
+      u[r] *= Masked ? wt[row] * inv_sigma[row] : inv_sigma[row];  // weights are 0 or 1
+    }
+    contact_impulse<R>(q, q + 9, q + 12, u, out + 6 * std::size_t(a),
+                       b >= 0 ? out + 6 * std::size_t(b) : nullptr);
+  }
+}
+
+template <template <int, bool> class F, typename... Args>
+void dispatch(const ContactSystem &sys, Args... args)
+{
+  const bool masked = sys.row_weight().size() > 0;
+  if (sys.rows() == 6) {
+    if (masked) F<6, true>::run(sys, args...);
+    else F<6, false>::run(sys, args...);
+  } else {
+    if (masked) F<3, true>::run(sys, args...);
+    else F<3, false>::run(sys, args...);
+  }
+}
+
+template <int R, bool M> struct GRun {
+  static void run(const ContactSystem &s, const double *w, const double *x, double *o)
+  {
+    g_kernel<R, M>(s, w, x, o);
+  }
+};
+template <int R, bool M> struct GtRun {
+  static void run(const ContactSystem &s, const double *l, double *o) { gt_kernel<R, M>(s, l, o); }
+};
+template <int R, bool M> struct GtgRun {
+  static void run(const ContactSystem &s, const double *w, double *o) { gtg_kernel<R, M>(s, w, o); }
+};
 
 }  // namespace
 
 void g_apply(const ContactSystem &sys, const Vector &w, Vector &out)
 {
-  const int rows = sys.rows(), nc = sys.num_contacts();
   out.resize(sys.contact_dofs());
-  double wt[kMaxRows];
-  for (int c = 0; c < nc; ++c) {
-    const Contact &k = sys.contacts()[c];
-    const ContactKinematics &q = sys.kinematics(c);
-    Vec6 u = side_velocity(q.frame, q.ra, w.data() + 6 * k.a);
-    if (!k.is_wall()) u -= side_velocity(q.frame, q.rb, w.data() + 6 * k.b);
-    row_weights(sys, c, wt);
-    for (int r = 0; r < rows; ++r) out[Eigen::Index(rows) * c + r] = wt[r] * u[r];
-  }
+  dispatch<GRun>(sys, w.data(), static_cast<const double *>(nullptr), out.data());
 }
 
 void gt_apply(const ContactSystem &sys, const Vector &lambda, Vector &out)
 {
-  const int rows = sys.rows(), nc = sys.num_contacts();
   out.setZero(sys.body_dofs());
-  double wt[kMaxRows];
-  for (int c = 0; c < nc; ++c) {
-    const Contact &k = sys.contacts()[c];
-    const ContactKinematics &q = sys.kinematics(c);
-    row_weights(sys, c, wt);
-    Vec6 l = Vec6::Zero();
-    for (int r = 0; r < rows; ++r) l[r] = wt[r] * lambda[Eigen::Index(rows) * c + r];
-    add_side_impulse(q.frame, q.ra, l, 1.0, out.data() + 6 * k.a);
-    if (!k.is_wall()) add_side_impulse(q.frame, q.rb, l, -1.0, out.data() + 6 * k.b);
-  }
+  dispatch<GtRun>(sys, lambda.data(), out.data());
 }
 
 void schur_apply(const ContactSystem &sys, const Exchange &ex, const Vector &x, Vector &y,
@@ -71,8 +228,8 @@ void schur_apply(const ContactSystem &sys, const Exchange &ex, const Vector &x, 
   ex.reverse_sum(work);
   work.array() *= sys.inv_mass().array();
   ex.forward(work);
-  g_apply(sys, work, y);
-  y.array() += sys.sigma().array() * x.array();
+  y.resize(sys.contact_dofs());
+  dispatch<GRun>(sys, static_cast<const double *>(work.data()), x.data(), y.data());
 }
 
 void body_apply(const ContactSystem &sys, const Exchange &ex, const Vector &x, Vector &y,
@@ -80,13 +237,11 @@ void body_apply(const ContactSystem &sys, const Exchange &ex, const Vector &x, V
 {
   work = x;
   ex.forward(work);
-  Vector t;
-  g_apply(sys, work, t);
-  t.array() /= sys.sigma().array();
-  gt_apply(sys, t, y);
+  y.setZero(sys.body_dofs());
+  dispatch<GtgRun>(sys, static_cast<const double *>(work.data()), y.data());
   ex.reverse_sum(y);
   const Eigen::Index owned = Eigen::Index(kBodyDofs) * sys.num_owned_bodies();
-  y.head(owned).array() += x.head(owned).array() / sys.inv_mass().head(owned).array();
+  y.head(owned).array() += x.head(owned).array() * sys.mass().head(owned).array();
   y.tail(y.size() - owned).setZero();
 }
 
@@ -188,7 +343,7 @@ Mat6 body_coupling_block(const ContactSystem &sys, int c)
 
 Vector mass_diagonal(const ContactSystem &sys)
 {
-  return sys.inv_mass().cwiseInverse();
+  return sys.mass();
 }
 
 }  // namespace fibre

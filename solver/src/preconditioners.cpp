@@ -422,7 +422,8 @@ class BlockBuilder {
   static constexpr int kPrefetch = 8;
 
   explicit BlockBuilder(const ContactSystem &sys)
-      : sys_(sys), rows_(sys.rows()), plain_(sys.row_mask().empty() && sys.rows() == kB)
+      : sys_(sys), pairs_(sys.body_pairs()), rows_(sys.rows()),
+        plain_(sys.row_mask().empty() && sys.rows() == kB)
   {
   }
 
@@ -449,7 +450,7 @@ class BlockBuilder {
   }
   int body(int c, int side) const
   {
-    return side == 0 ? sys_.contacts()[c].a : sys_.contacts()[c].b;
+    return pairs_[2 * std::size_t(c) + side];  // b = -1 for walls
   }
   // Contact loops run in contact order, but bodies are scattered: ask for the inverse masses
   // of the contact kPrefetch ahead (c may be past the end) and, if given, of another contact.
@@ -458,12 +459,12 @@ class BlockBuilder {
 #if defined(__GNUC__)
     const int ahead = c + kPrefetch;
     if (ahead < sys_.num_contacts()) {
-      const Contact &k = sys_.contacts()[ahead];
-      __builtin_prefetch(sys_.inv_mass().data() + 6 * k.a);
-      if (k.b >= 0) __builtin_prefetch(sys_.inv_mass().data() + 6 * k.b);
+      const int a = pairs_[2 * std::size_t(ahead)], b = pairs_[2 * std::size_t(ahead) + 1];
+      __builtin_prefetch(sys_.inv_mass().data() + 6 * a);
+      if (b >= 0) __builtin_prefetch(sys_.inv_mass().data() + 6 * b);
     }
     if (other >= 0) {
-      __builtin_prefetch(&sys_.contacts()[other]);
+      __builtin_prefetch(pairs_ + 2 * std::size_t(other));
       __builtin_prefetch(&sys_.kinematics(other));
     }
 #else
@@ -494,7 +495,7 @@ class BlockBuilder {
   {
     // Sums over the sides of mu I + iota Q Q^T (top left), iota Q (bottom left), iota I.
     double t00 = 0, t11 = 0, t22 = 0, t10 = 0, t20 = 0, t21 = 0, qa = 0, qb = 0, qc = 0, ri = 0;
-    const int sides = sys_.contacts()[c].is_wall() ? 1 : 2;
+    const int sides = pairs_[2 * std::size_t(c) + 1] < 0 ? 1 : 2;
     Skew lev[2];
     levers(c, lev[0], lev[1]);
     for (int side = 0; side < sides; ++side) {
@@ -622,7 +623,7 @@ class BlockBuilder {
     const ContactKinematics &q = sys_.kinematics(c);
     M3 Xa, Xb, SX;
     world_side(Pt, Pr, q.ra, Xa, SX, Kaa);
-    if (sys_.contacts()[c].is_wall()) return;
+    if (pairs_[2 * std::size_t(c) + 1] < 0) return;
     world_side(Pt, Pr, q.rb, Xb, SX, Kbb);
     if (!Kab) return;
     // K_ab = -[P_t, -X_b; -X_a^T, -S_a X_b + P_r].
@@ -665,6 +666,7 @@ class BlockBuilder {
   }
 
   const ContactSystem &sys_;
+  const int *pairs_;  // body pairs, 2 per contact (flat: 8 bytes a contact)
   int rows_;
   bool plain_;  // six rows and no mask: the weights are all one
 };
@@ -742,18 +744,20 @@ std::unique_ptr<Preconditioner> contact_tree(const ContactSystem &sys, const Pre
   if (stats) *stats = forest.stats;
   const BlockBuilder blocks(sys);
   const int nb = sys.num_bodies(), nc = sys.num_contacts(), rows = sys.rows();
-  const std::vector<Contact> &contacts = sys.contacts();
+  const int *pairs = sys.body_pairs();  // a, b per contact; b = -1 for walls
+  auto body_a = [&](int c) { return pairs[2 * std::size_t(c)]; };
+  auto body_b = [&](int c) { return pairs[2 * std::size_t(c) + 1]; };
 
   // Wall contacts per body (CSR) and whether a body has tree children.
   std::vector<int> wall_start(nb + 1, 0), walls;
-  for (const Contact &k : contacts)
-    if (k.is_wall()) ++wall_start[k.a + 1];
+  for (int c = 0; c < nc; ++c)
+    if (body_b(c) < 0) ++wall_start[body_a(c) + 1];
   for (int i = 0; i < nb; ++i) wall_start[i + 1] += wall_start[i];
   walls.resize(wall_start[nb]);
   {
     std::vector<int> fill(wall_start.begin(), wall_start.end() - 1);
     for (int c = 0; c < nc; ++c)
-      if (contacts[c].is_wall()) walls[fill[contacts[c].a]++] = c;
+      if (body_b(c) < 0) walls[fill[body_a(c)]++] = c;
   }
   std::vector<char> has_child(nb, 0);
   for (int i = 0; i < nb; ++i)
@@ -774,8 +778,8 @@ std::unique_ptr<Preconditioner> contact_tree(const ContactSystem &sys, const Pre
 
   // The tree contact's parent: its wall body, or the end nearer the root.
   auto parent_body = [&](int c) {
-    const Contact &k = contacts[c];
-    return k.is_wall() ? k.a : forest.parent[k.a] == k.b ? k.b : k.a;
+    const int a = body_a(c), b = body_b(c);
+    return b < 0 ? a : forest.parent[a] == b ? b : a;
   };
   ForestFactor f(n, rows);
   for (int i = 0; i < nb; ++i)
@@ -791,7 +795,7 @@ std::unique_ptr<Preconditioner> contact_tree(const ContactSystem &sys, const Pre
     const int pc = forest.parent_contact[i];
     f.set_diag(body_node[i], Vec6(inv_mass.segment<6>(6 * i).cwiseInverse()));
     if (pc >= 0)
-      f.coupling(body_node[i]) = -blocks.jacobian(pc, contacts[pc].a == i ? 0 : 1).transpose();
+      f.coupling(body_node[i]) = -blocks.jacobian(pc, body_a(pc) == i ? 0 : 1).transpose();
   }
   for (int c = 0; c < nc; ++c) {
     blocks.prefetch(c);
@@ -803,7 +807,7 @@ std::unique_ptr<Preconditioner> contact_tree(const ContactSystem &sys, const Pre
     Vec6 d = Vec6::Ones();
     for (int r = 0; r < rows; ++r) d[r] = sys.sigma()[Eigen::Index(rows) * c + r];
     f.set_diag(contact_node[c], d);
-    f.coupling(contact_node[c]) = -blocks.jacobian(c, parent_body(c) == contacts[c].a ? 0 : 1);
+    f.coupling(contact_node[c]) = -blocks.jacobian(c, parent_body(c) == body_a(c) ? 0 : 1);
   }
   return finish("tree", std::move(f), sys.contact_dofs(), true);
 }
@@ -835,15 +839,20 @@ void body_blocks(const ContactSystem &sys, const Exchange &ex, const std::vector
       for (int i = j; i < kB; ++i) l[at(i, j)] += m(i, j);
   };
   Mat6 Kaa, Kbb, Kab;
+  const int *pairs = sys.body_pairs();
+  struct Pair {
+    int a, b;
+    bool is_wall() const { return b < 0; }
+  };
   for (int c = 0; c < sys.num_contacts(); ++c) {
 #if defined(__GNUC__)
     if (c + BlockBuilder::kPrefetch < sys.num_contacts()) {  // scattered bodies: see prefetch()
-      const Contact &ahead = sys.contacts()[c + BlockBuilder::kPrefetch];
-      __builtin_prefetch(packed(ahead.a));
-      if (ahead.b >= 0) __builtin_prefetch(packed(ahead.b));
+      const std::size_t ahead = 2 * std::size_t(c + BlockBuilder::kPrefetch);
+      __builtin_prefetch(packed(pairs[ahead]));
+      if (pairs[ahead + 1] >= 0) __builtin_prefetch(packed(pairs[ahead + 1]));
     }
 #endif
-    const Contact &k = sys.contacts()[c];
+    const Pair k{pairs[2 * std::size_t(c)], pairs[2 * std::size_t(c) + 1]};
     const bool inner = link && !k.is_wall() && k.a < owned && k.b < owned;
     const bool a_to_b = inner && (*link)[k.a] == k.b, b_to_a = inner && (*link)[k.b] == k.a;
     blocks.body_parts(c, Kaa, Kbb, a_to_b || b_to_a ? &Kab : nullptr);

@@ -81,10 +81,14 @@ void ContactSystem::compute_derived()
     inv_mass_.segment<3>(6 * i).setConstant(1.0 / b.mass);
     inv_mass_.segment<3>(6 * i + 3).setConstant(1.0 / inertia);
   }
+  mass_ = inv_mass_.cwiseInverse();
   kin_.resize(nc);
   sigma_.resize(contact_dofs());
+  pairs_.resize(std::size_t(2) * nc);
   for (int c = 0; c < nc; ++c) {
     const Contact &k = contacts_[c];
+    pairs_[2 * std::size_t(c)] = k.a;
+    pairs_[2 * std::size_t(c) + 1] = k.is_wall() ? -1 : k.b;
     ContactKinematics &q = kin_[c];
     q.frame.row(0) = k.normal.transpose();
     q.frame.row(1) = k.t1.transpose();
@@ -95,6 +99,14 @@ void ContactSystem::compute_derived()
       const Eigen::Index row = Eigen::Index(rows_) * c + r;
       sigma_[row] = row_active(row) ? params_.sigma(k.compliance[r]) : 1.0;
     }
+  }
+  inv_sigma_ = sigma_.cwiseInverse();
+  if (mask_.empty()) {
+    row_weight_.resize(0);
+  } else {
+    row_weight_.resize(contact_dofs());
+    for (Eigen::Index row = 0; row < contact_dofs(); ++row)
+      row_weight_[row] = mask_[row] ? 1.0 : 0.0;
   }
 }
 

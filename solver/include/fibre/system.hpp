@@ -93,9 +93,17 @@ class ContactSystem {
   const std::vector<Contact> &contacts() const { return contacts_; }
   const ContactKinematics &kinematics(int c) const { return kin_[c]; }
   const Vector &inv_mass() const { return inv_mass_; }  // diagonal of M^-1, 6 per body
+  const Vector &mass() const { return mass_; }          // diagonal of M, 6 per body
   const Vector &sigma() const { return sigma_; }        // diagonal of Sigma, rows per contact
   const Vector &rhs() const { return rhs_; }
   void set_rhs(const Vector &b) { rhs_ = b; }
+
+  // Flat data for the matrix-free kernels (derived, kept in step with contacts and mask):
+  // the two bodies of every contact (a, b; b = -1 for walls) as 2 ints per contact, 1 / Sigma
+  // per row, and the row weights (1 active, 0 masked) per row, empty when no row is masked.
+  const int *body_pairs() const { return pairs_.data(); }
+  const Vector &inv_sigma() const { return inv_sigma_; }
+  const Vector &row_weight() const { return row_weight_; }
 
   // Active-set support: a masked row has a zero Jacobian row, Sigma 1 and rhs 0, so it is
   // decoupled (its lambda solves to 0) while every block structure stays intact.
@@ -119,7 +127,11 @@ class ContactSystem {
   std::vector<ContactKinematics> kin_;
   std::vector<unsigned char> mask_;  // empty = all rows active
   Vector inv_mass_;
+  Vector mass_;
   Vector sigma_;
+  Vector inv_sigma_;
+  Vector row_weight_;       // empty = all rows active
+  std::vector<int> pairs_;  // a, b per contact
   Vector rhs_;
 };
 

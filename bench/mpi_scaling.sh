@@ -1,0 +1,91 @@
+#!/bin/bash
+# Strong scaling of fix fibre_contact under MPI: the same deck at 1, 2, ... ranks, with the
+# parallel efficiency T1 / (p Tp), the fix's own timings (f_fc[8] preconditioner setup and
+# f_fc[9] linear solve, seconds per step, slowest process, averaged over every step with fix
+# ave/time) and LAMMPS's MPI task timing breakdown (Pair/Neigh/Comm/Modify/Output/Other;
+# the fix's contact detection, system build, preconditioner and solve are all in Modify).
+#
+# Usage: bench/mpi_scaling.sh [options]
+#   --np "1 2"          rank counts (e.g. "1 2 4 8 16" on a larger machine)
+#   --deck material     examples/<deck>/in.<deck> (material or silo)
+#   --N 1400            spheres (-var N)
+#   --tend 2.0          simulated seconds (material: -var tend; silo: -var tfill, no discharge)
+#   --lmp PATH          lmp_fibre (default build/fix/lmp_fibre)
+#   --work DIR          work directory (default /tmp/fibre_mpi_scaling)
+#   --extra "KEYS"      more fix fibre_contact keywords (-var fc_extra), e.g. "precond fibre"
+#   --mpirun-flags "F"  flags for mpirun (default: --mca btl_vader_single_copy_mechanism none,
+#                       see below; pass "" for Open MPI's defaults)
+# Open MPI's shared-memory transport copies messages above its 4 KB eager limit with a
+# single-copy mechanism (CMA) that is slow in containers without ptrace rights: here a 7 KB
+# halo message took 51 us with it and 3.4 us without (bench_mpi_latency), and a Krylov
+# iteration makes several such exchanges. The default flag turns it off.
+# The deck is copied into the work directory with its thermo columns set to the fix's timings
+# (the examples themselves are not modified). Needs mpirun; as root, Open MPI wants
+# OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 (set below); more ranks than
+# cores needs --oversubscribe (added automatically when np > cores).
+set -euo pipefail
+src=$(cd "$(dirname "$0")/.." && pwd)
+nps="1 2"
+deck=material
+N=1400
+tend=2.0
+lmp=$src/build/fix/lmp_fibre
+work=/tmp/fibre_mpi_scaling
+extra=""
+mpirun_flags="--mca btl_vader_single_copy_mechanism none"
+while [ $# -gt 0 ]; do
+  case $1 in
+    --np) nps=$2; shift 2 ;;
+    --deck) deck=$2; shift 2 ;;
+    --N) N=$2; shift 2 ;;
+    --tend) tend=$2; shift 2 ;;
+    --lmp) lmp=$2; shift 2 ;;
+    --work) work=$2; shift 2 ;;
+    --extra) extra=$2; shift 2 ;;
+    --mpirun-flags) mpirun_flags=$2; shift 2 ;;
+    *) echo "unknown option $1" >&2; exit 2 ;;
+  esac
+done
+export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 OMP_NUM_THREADS=1
+cores=$(getconf _NPROCESSORS_ONLN)
+mkdir -p "$work"
+cp "$src/examples/$deck/"*."$deck" "$work/"
+cd "$work"
+# Timing columns instead of the deck's fibre_thermo, and per-step averages of the fix's
+# timings over the whole run, printed at the end.
+sed -i 's/^variable  *fibre_thermo string .*/variable  fibre_thermo string "f_fc[1] f_fc[3] f_fc[8] f_fc[9]"/' "in.$deck"
+sed -i "s/^include  *run\.$deck/fix       fc_time all ave\/time 1 1 1 f_fc[8] f_fc[9] ave running\n&/" "in.$deck"
+echo 'print "fibre_timing setup_per_step $(f_fc_time[1]) solve_per_step $(f_fc_time[2])"' >> "in.$deck"
+case $deck in
+  material) timevar="-var tend $tend" ;;
+  silo) timevar="-var tfill $tend -var tflow 0" ;;
+  *) timevar="" ;;
+esac
+
+echo "mpi_scaling: $(date -u '+%Y-%m-%d %H:%M UTC'), $(hostname), $cores cores;" \
+     "deck $deck N $N tend $tend, extra '$extra', mpirun flags '$mpirun_flags'"
+printf '%4s %10s %8s %8s %10s %10s %8s %8s %8s %8s %8s\n' np loop_s speedup eff \
+  setup_ms/st solve_ms/st pair% neigh% comm% modify% other%
+t1=""
+for np in $nps; do
+  over=""
+  [ "$np" -gt "$cores" ] && over="--oversubscribe"
+  log=log.np$np
+  # shellcheck disable=SC2086
+  mpirun $mpirun_flags $over -np "$np" "$lmp" -in "in.$deck" -var N "$N" $timevar -var fc_extra "$extra" \
+    -log "$log" -screen none > "out.np$np" 2>&1 || { echo "np $np failed, see $work/out.np$np"; continue; }
+  loop=$(sed -n 's/^Loop time of \([0-9.e+-]*\) on .*/\1/p' "$log" | tail -1)
+  steps=$(sed -n 's/.* for \([0-9]*\) steps with .*/\1/p' "$log" | tail -1)
+  timing=$(sed -n 's/^fibre_timing setup_per_step \([^ ]*\) solve_per_step \([^ ]*\)/\1 \2/p' "$log" | tail -1)
+  pct() { awk -v k="$1" '$1 == k && $2 == "|" { print $NF }' "$log" | tail -1; }
+  [ -z "$t1" ] && t1=$loop && p1=$np
+  awk -v np="$np" -v loop="$loop" -v t1="$t1" -v p1="$p1" -v tm="$timing" \
+      -v pair="$(pct Pair)" -v neigh="$(pct Neigh)" -v comm="$(pct Comm)" \
+      -v modify="$(pct Modify)" -v other="$(pct Other)" 'BEGIN {
+    split(tm, t, " ");
+    s = t1 / loop; e = s * p1 / np;
+    printf "%4d %10.2f %8.2f %7.0f%% %10.2f %10.2f %8s %8s %8s %8s %8s\n", np, loop, s, 100 * e,
+      1e3 * t[1], 1e3 * t[2], pair, neigh, comm, modify, other }'
+  echo "     ($steps steps; LAMMPS log $work/$log)"
+done
+echo "eff = T(first) * np(first) / (np * T): parallel efficiency of the loop time"

@@ -1,0 +1,91 @@
+"""Material scene (examples/material): a short pour of the shipped decks.
+
+Runs examples/material/in.material (fix fibre_contact) with N = 350 for 2.5 simulated
+seconds and the native twin in.material.native (lmp_fibre is a drop-in lmp) for the same
+time. Checks: the emitter inserts its batches of 81 spheres (3 batches by t = 2.5 s), all
+thermo values finite, no sphere lost, the deepest overlap (f_fc[7]) below 2% of the smallest
+diameter, the spheres reach the plane (lowest sphere top below 1.5), and fibre_contact and
+the native twin agree on the mass-weighted mean height of the spheres within 10%.
+Then a short run (0.3 s) serial and on two processes (np 2 is slow on an oversubscribed
+machine): both complete, insert the first batch, and agree on the kinetic energy within 5%.
+"""
+
+import os
+import shutil
+
+import fibre_e2e as e2e
+
+N, TEND, PER_BATCH, BATCHES = 350, 2.5, 81, 3
+
+
+def copy_scene(args):
+    src = os.path.join(args.source, "examples", "material")
+    for f in ("in.material", "in.material.native", "scene.material", "run.material"):
+        shutil.copy(os.path.join(src, f), args.workdir)
+
+
+def deck(args, name):
+    with open(os.path.join(args.workdir, name)) as f:
+        return f.read()
+
+
+def mean_height(args, method):
+    frame = e2e.parse_dump(os.path.join(args.workdir, "pile.%s.%d.dump" % (method, N)))[-1]
+    atoms = e2e.dump_by_id(frame)
+    m = sum(a["mass"] for a in atoms.values())
+    return sum(a["mass"] * a["z"] for a in atoms.values()) / m, atoms
+
+
+def main():
+    args = e2e.parse_args()
+    ck = e2e.Checks("scene: material, N %d, %.1f s" % (N, TEND))
+    copy_scene(args)
+    heights = {}
+    for tag, np_, name in (("serial", 1, "in.material"), ("native", 1, "in.material.native")):
+        run = e2e.run_lmp(args, deck(args, name), "material_" + tag, np=np_,
+                          variables={"N": N, "tend": TEND})
+        if not ck.ran(run, "%s: material deck completes" % tag):
+            continue
+        rows = run.thermo[-1]
+        ins = [l for l in run.log.splitlines() if l.startswith("Particle insertion:")]
+        ck.check(bool(ins) and ins[-1].split()[2] == str(PER_BATCH),
+                 "%s: emitter batches of %d" % (tag, PER_BATCH), ins[-1] if ins else "no line")
+        atoms = rows[-1]["Atoms"]
+        ck.check(atoms == PER_BATCH * BATCHES, "%s: %d spheres inserted, none lost"
+                 % (tag, PER_BATCH * BATCHES), "%g atoms" % atoms)
+        ck.check(all(e2e.finite(list(r.values())) for r in rows), "%s: thermo finite" % tag)
+        if "f_fc[7]" in rows[-1]:
+            worst = max(r["f_fc[7]"] for r in rows)
+            ck.check(worst < 0.02 * 0.5, "%s: deepest overlap below 2%% of d_min" % tag,
+                     "max f_fc[7] = %.3g" % worst)
+        method = "native" if tag == "native" else "fibre"
+        h, dump = mean_height(args, method)
+        lowest = min(a["z"] + a["radius"] for a in dump.values())
+        ck.check(lowest < 1.5, "%s: spheres reach the plane" % tag,
+                 "lowest sphere top %.3g" % lowest)
+        heights[tag] = h
+        # the two fibre runs write the same dump name: keep the serial one apart
+        os.replace(os.path.join(args.workdir, "pile.%s.%d.dump" % (method, N)),
+                   os.path.join(args.workdir, "pile.%s.%d.%s.dump" % (method, N, tag)))
+    ke = {}
+    for tag, np_ in (("short_serial", 1), ("short_np2", 2)):
+        run = e2e.run_lmp(args, deck(args, "in.material"), "material_" + tag, np=np_,
+                          variables={"N": N, "tend": 0.3})
+        if ck.ran(run, "%s: material deck completes" % tag):
+            last = run.thermo[-1][-1]
+            ck.check(last["Atoms"] == PER_BATCH, "%s: first batch inserted" % tag,
+                     "%g atoms" % last["Atoms"])
+            ke[tag] = last["c_ke"]
+    if len(ke) == 2:
+        ck.check(e2e.rel_err(ke["short_serial"], ke["short_np2"]) < 0.05,
+                 "serial and np 2 agree on the kinetic energy",
+                 "%.6g vs %.6g" % (ke["short_serial"], ke["short_np2"]))
+    if "serial" in heights and "native" in heights:
+        ck.check(e2e.rel_err(heights["serial"], heights["native"]) < 0.10,
+                 "fibre_contact and native agree on the mean height",
+                 "%.4g vs %.4g" % (heights["serial"], heights["native"]))
+    ck.close()
+
+
+if __name__ == "__main__":
+    main()
