@@ -4,9 +4,8 @@ Runs examples/silo/in.silo (fix fibre_contact) with N = 350 and orifice D = 4: t
 inserts all 350 spheres in one batch, they fall into the plugged funnel for TFILL seconds,
 then the plug is removed (the funnel region is redefined) and they flow for TFLOW seconds.
 Serial, and the native twin in.silo.native. Checks: 350 inserted and none lost while
-plugged, thermo finite, the deepest overlap (f_fc[7], walls included) below 50% of the
-smallest diameter (the 2% target is missed: a known defect of the active set in jams, see
-the check), every sphere inside the funnel before opening (within 10% of d_min: none below the plug or
+plugged, thermo finite, the deepest overlap (f_fc[7], walls included) below 5% of the
+smallest diameter (the 2% target is missed on single steps of the fill, see the check), every sphere inside the funnel before opening (within 10% of d_min: none below the plug or
 outside the orifice), mass
 leaves through the orifice after opening. Then a short fill (0.3 s) serial and on two
 processes (np 2 is slow on an oversubscribed machine): both complete, insert all 350, and
@@ -42,13 +41,11 @@ def main():
         ck.check(all(e2e.finite(list(r.values())) for r in fill + flow), "%s: thermo finite" % tag)
         if "f_fc[7]" in fill[-1]:
             worst = max(r["f_fc[7]"] for r in fill + flow)
-            # Known defect (issue #5 note): when a sphere is jammed between the cone and two
-            # spheres, the active set can end unsettled and the final projection zeroes a
-            # tensile impulse that balanced two large compressive ones; single steps then
-            # overlap by up to ~0.2 (40% of d_min). The 2% target is missed; this bound only
-            # guards against spheres passing through each other.
-            ck.check(worst < 0.5 * 0.5, "%s: no sphere passes through another (deepest "
-                     "overlap below 50%% of d_min; target 2%% missed, known defect)" % tag,
+            # Single steps of the fill, where spheres land at ~20 m/s and jam against the
+            # cone, overlap by 2-4% of d_min (measured 0.011-0.021 at N 350 with the polish
+            # sweeps; 0.06-0.2 without them). The 2% target is missed by that much.
+            ck.check(worst < 0.05 * 0.5, "%s: deepest overlap below 5%% of d_min (target 2%%, "
+                     "missed on single steps of the fill)" % tag,
                      "max f_fc[7] = %.3g = %.1f%% of d_min" % (worst, 100 * worst / 0.5))
         method = "native" if tag == "native" else "fibre"
         filled = os.path.join(args.workdir, "silo.%s.%d.filled.dump" % (method, N))

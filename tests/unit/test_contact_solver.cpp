@@ -357,3 +357,41 @@ TEST(ContactSolver, NonFiniteInputGivesFiniteResult)
     EXPECT_TRUE(res.dv.allFinite());
   }
 }
+
+// A loop cut short (one pass) is finished by projected block-Jacobi sweeps: the impulses are
+// feasible and the velocities closer to the settled answer than after a plain projection.
+TEST(ContactSolver, PolishAfterUnsettledLoop)
+{
+  SceneParams p;
+  p.seed = 11;
+  ContactSystem sys = pile_scene(80, p);
+  StepOptions ref_opt;
+  ref_opt.solver = SolverKind::direct;
+  ref_opt.active_set_max = 60;
+  ref_opt.friction.mu = 0.4;
+  ref_opt.friction.mu_roll = 0.02;
+  const StepResult ref = solve(sys, ref_opt);
+  ASSERT_TRUE(ref.set_settled);
+
+  StepOptions o = ref_opt;
+  o.solver = SolverKind::cr;
+  o.stop.tol = 1e-10;
+  o.active_set_max = 1;
+  o.polish_sweeps = 0;
+  const StepResult plain = solve(sys, o);
+  o.polish_sweeps = 10;
+  const StepResult polished = solve(sys, o);
+  ASSERT_FALSE(plain.set_settled);
+  ASSERT_FALSE(polished.set_settled);
+  // measured: 95.5 (plain) and 22.1 (polished), relative to the settled velocities
+  const double err_plain = rel_diff(plain.dv, ref.dv);
+  const double err_polished = rel_diff(polished.dv, ref.dv);
+  EXPECT_LT(err_polished, 0.5 * err_plain) << "plain " << err_plain << ", polished "
+                                           << err_polished;
+  const int rows = sys.rows();
+  for (int c = 0; c < sys.num_contacts(); ++c) {
+    const double ln = polished.lambda[rows * c];
+    ASSERT_GE(ln, 0.0);
+    EXPECT_LE(polished.lambda.segment(rows * c + 1, 2).norm(), 0.4 * ln * (1 + 1e-12));
+  }
+}

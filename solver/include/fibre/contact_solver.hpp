@@ -39,6 +39,9 @@ struct StepOptions {
   // pass, are solved to stop.tol. 1e-4 needed 1.5x fewer Krylov iterations than 1e-6 in the
   // material scene (doc/fix_fibre_contact.md).
   double pass_tol = 1e-4;
+  // A loop that ends unsettled is finished by this many projected block-Jacobi sweeps on the
+  // full system instead of a plain projection (0: plain projection).
+  int polish_sweeps = 10;
 };
 
 // Counts (released, capped) are global over all processes; so are the Krylov figures.
