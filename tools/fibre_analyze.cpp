@@ -83,7 +83,15 @@ options:
                                form without preconditioner, otherwise Lanczos (500 steps),
                                dense after all when that does not converge and n <= 8000);
                                without --spectra it prints the kappa_e table, writes no files
+  --lanczos-steps N            most Lanczos steps of --kappa lanczos (default 2000; auto: 500)
   --sigma-scale S              multiply Sigma (every compliance) by S > 0 (default 1)
+  --combine LIST               add combined preconditioners (multipreconditioning), from
+                               add_fibre_tree  P^-1 = (F^-1 + T^-1) / 2 (fibre and tree)
+                               mul_tree_fibre  symmetric multiplicative T, F, T:
+                                               z = T r; z += F (r - A z); z += T (r - A z)
+                               add_fibre_zs    (F_z^-1 + F_straight^-1) / 2 (two weights)
+                               add_tree_zs     (T_z^-1 + T_straight^-1) / 2 (two weights)
+                               run after the --precond list, named as above
   -h, --help                   print this text
 
 exit status: 0 done, 1 the computation failed, 2 bad arguments or unreadable input
@@ -112,7 +120,9 @@ struct Options {
   std::string spectra_prefix;
   bool kappa = false;  // compute the spectra (--spectra or --kappa)
   KappaMethod kappa_method = KappaMethod::automatic;
+  int lanczos_steps = 0;  // 0: the default of the kappa method
   double sigma_scale = 1.0;
+  std::vector<std::string> combos;  // --combine
   bool help = false;
 };
 
@@ -192,7 +202,8 @@ Options parse_args(int argc, char **argv)
       have_value = true;
     }
     const char *const known[] = {"--form",   "--methods", "--precond", "--weight",     "--maxiter",
-                                 "--csv",    "--spectra", "--kappa",   "--sigma-scale"};
+                                 "--csv",    "--spectra", "--kappa",   "--sigma-scale",
+                                 "--combine", "--lanczos-steps"};
     if (std::find(std::begin(known), std::end(known), arg) == std::end(known))
       throw UsageError("unknown option '" + arg + "'");
     if (!have_value) {
@@ -236,6 +247,19 @@ Options parse_args(int argc, char **argv)
       opt.kappa = true;
     } else if (arg == "--sigma-scale") {
       opt.sigma_scale = parse_positive_real(arg, value);
+    } else if (arg == "--lanczos-steps") {
+      opt.lanczos_steps = parse_positive_int(arg, value);
+    } else if (arg == "--combine") {
+      opt.combos.clear();
+      for (const std::string &item : split_list(arg, value)) {
+        if (item != "add_fibre_tree" && item != "mul_tree_fibre" && item != "add_fibre_zs" &&
+            item != "add_tree_zs")
+          throw UsageError("--combine: unknown entry '" + item +
+                           "' (allowed: add_fibre_tree, mul_tree_fibre, add_fibre_zs, "
+                           "add_tree_zs)");
+        if (std::find(opt.combos.begin(), opt.combos.end(), item) == opt.combos.end())
+          opt.combos.push_back(item);
+      }
     }
   }
   if (positional.empty()) throw UsageError("no system file given");
@@ -402,6 +426,64 @@ struct PrecondEntry {
   std::unique_ptr<Preconditioner> P;
   FibreStats stats;
   double setup_seconds = 0;
+  std::string name;      // to_string(kind), or the --combine entry
+  bool combined = false;
+};
+
+// ---- multipreconditioning (--combine) ----
+
+// P^-1 = (P1^-1 + P2^-1) / 2: symmetric positive definite when both are.
+class AveragePreconditioner final : public Preconditioner {
+ public:
+  AveragePreconditioner(std::unique_ptr<Preconditioner> a, std::unique_ptr<Preconditioner> b,
+                        std::string name)
+      : a_(std::move(a)), b_(std::move(b)), name_(std::move(name))
+  {
+  }
+  void apply(const Vector &r, Vector &z) const override
+  {
+    a_->apply(r, z);
+    b_->apply(r, tmp_);
+    z = 0.5 * (z + tmp_);
+  }
+  std::string name() const override { return name_; }
+
+ private:
+  std::unique_ptr<Preconditioner> a_, b_;
+  std::string name_;
+  mutable Vector tmp_;
+};
+
+// Symmetric multiplicative combination (outer O, inner I), as a symmetric Gauss-Seidel sweep
+// over the two preconditioners:
+//   z = O r; z += I (r - A z); z += O (r - A z)
+// symmetric; two more operator applies per use.
+class SymmetricProductPreconditioner final : public Preconditioner {
+ public:
+  SymmetricProductPreconditioner(const LinearOperator &A, std::unique_ptr<Preconditioner> outer,
+                                 std::unique_ptr<Preconditioner> inner, std::string name)
+      : A_(A), outer_(std::move(outer)), inner_(std::move(inner)), name_(std::move(name))
+  {
+  }
+  void apply(const Vector &r, Vector &z) const override
+  {
+    outer_->apply(r, z);
+    A_.apply(z, Az_);
+    res_ = r - Az_;
+    inner_->apply(res_, tmp_);
+    z += tmp_;
+    A_.apply(z, Az_);
+    res_ = r - Az_;
+    outer_->apply(res_, tmp_);
+    z += tmp_;
+  }
+  std::string name() const override { return name_; }
+
+ private:
+  const LinearOperator &A_;
+  std::unique_ptr<Preconditioner> outer_, inner_;
+  std::string name_;
+  mutable Vector Az_, res_, tmp_;
 };
 
 struct FormSetup {
@@ -437,9 +519,37 @@ FormSetup setup_form(Form form, const ContactSystem &sys, const Options &opt,
     po.kind = kind;
     po.weight = opt.weight;
     po.impulses = impulses;
-    PrecondEntry e{kind, nullptr, {}, 0};
+    PrecondEntry e{kind, nullptr, {}, 0, to_string(kind), false};
     const auto t0 = std::chrono::steady_clock::now();
     e.P = make_preconditioner(form, sys, ex, po, &e.stats);
+    e.setup_seconds = seconds_since(t0);
+    fs.preconds.push_back(std::move(e));
+  }
+  auto build = [&](PrecondKind kind, EdgeWeight weight) {
+    PrecondOptions po;
+    po.kind = kind;
+    po.weight = weight;
+    po.impulses = impulses;
+    return make_preconditioner(form, sys, ex, po, nullptr);
+  };
+  for (const std::string &combo : opt.combos) {
+    PrecondEntry e{PrecondKind::tree, nullptr, {}, 0, combo, true};
+    const auto t0 = std::chrono::steady_clock::now();
+    if (combo == "add_fibre_tree")
+      e.P = std::make_unique<AveragePreconditioner>(build(PrecondKind::fibre, opt.weight),
+                                                    build(PrecondKind::tree, opt.weight), combo);
+    else if (combo == "mul_tree_fibre")
+      e.P = std::make_unique<SymmetricProductPreconditioner>(
+          *fs.op, build(PrecondKind::tree, opt.weight), build(PrecondKind::fibre, opt.weight),
+          combo);
+    else if (combo == "add_fibre_zs")
+      e.P = std::make_unique<AveragePreconditioner>(
+          build(PrecondKind::fibre, EdgeWeight::z), build(PrecondKind::fibre, EdgeWeight::straight),
+          combo);
+    else  // add_tree_zs
+      e.P = std::make_unique<AveragePreconditioner>(
+          build(PrecondKind::tree, EdgeWeight::z), build(PrecondKind::tree, EdgeWeight::straight),
+          combo);
     e.setup_seconds = seconds_since(t0);
     fs.preconds.push_back(std::move(e));
   }
@@ -457,8 +567,8 @@ void describe_form(const FormSetup &fs, const Options &opt)
   std::printf("  ||rhs|| = %.6g%s\n", fs.rhs_norm,
               fs.form == Form::body ? " (G^T Sigma^-1 b)" : "");
   for (const PrecondEntry &e : fs.preconds) {
-    std::printf("  precond %-7s setup %.3f s", to_string(e.kind), e.setup_seconds);
-    if (e.kind == PrecondKind::fibre || e.kind == PrecondKind::tree)
+    std::printf("  precond %-7s setup %.3f s", e.name.c_str(), e.setup_seconds);
+    if (!e.combined && (e.kind == PrecondKind::fibre || e.kind == PrecondKind::tree))
       std::printf("; %s weight: %d %s covering %d of %d body-body contacts (%.1f%%)",
                   to_string(opt.weight), e.stats.num_fibres,
                   e.kind == PrecondKind::fibre ? "fibres" : "trees", e.stats.contacts_in_fibres,
@@ -476,7 +586,7 @@ struct IterationRow {
 
 struct Run {
   Method method;
-  PrecondKind kind;
+  std::string precond;
   SolveResult result;
   std::vector<IterationRow> rows;
   double seconds = 0;
@@ -486,7 +596,7 @@ Run run_krylov(const FormSetup &fs, const PrecondEntry &pe, Method method,
                const ContactSystem &sys, const Reference &ref)
 {
   const Exchange &ex = serial_exchange();
-  Run run{method, pe.kind, {}, {}, 0};
+  Run run{method, pe.name, {}, {}, 0};
   Vector Ax, dv;
   KrylovMonitor monitor;
   monitor.record_history = true;
@@ -546,7 +656,7 @@ void print_run(const Run &run)
   }
   const std::string best_s =
       best ? sci(best->ve_rel) + "(" + std::to_string(best->iteration) + ")" : "-";
-  std::printf("  %-7s %-6s %6d %-14s %9s %9s %9s %10s %14s %8s %7.2f\n", to_string(run.kind),
+  std::printf("  %-7s %-6s %6d %-14s %9s %9s %9s %10s %14s %8s %7.2f\n", run.precond.c_str(),
               to_string(run.method), run.result.iterations, to_string(run.result.reason),
               at ? (sci(at->rr) + mark).c_str() : "-", at ? (sci(at->rb) + mark).c_str() : "-",
               at ? (sci(at->ve) + mark).c_str() : "-",
@@ -558,7 +668,7 @@ void print_run(const Run &run)
 void write_run_csv(std::ostream &csv, Form form, const Run &run)
 {
   for (const IterationRow &r : run.rows)
-    csv << to_string(form) << ',' << to_string(run.method) << ',' << to_string(run.kind) << ','
+    csv << to_string(form) << ',' << to_string(run.method) << ',' << run.precond << ','
         << r.iteration << ',' << r.rr << ',' << r.rb << ',' << r.ve << ',' << r.ve_rel << '\n';
 }
 
@@ -567,6 +677,7 @@ void write_run_csv(std::ostream &csv, Form form, const Run &run)
 struct SpectrumRun {
   Form form;
   PrecondKind kind;
+  std::string precond;  // name
   Eigen::Index n = 0;
   Spectrum s;
   std::string method;  // how it was computed
@@ -575,15 +686,17 @@ struct SpectrumRun {
 };
 
 SpectrumRun compute_spectrum(const FormSetup &fs, const PrecondEntry &pe,
-                             const ContactSystem &sys, KappaMethod how)
+                             const ContactSystem &sys, KappaMethod how, int lanczos_steps)
 {
   SpectrumRun run;
   run.form = fs.form;
   run.kind = pe.kind;
+  run.precond = pe.name;
   run.n = fs.op->size();
   const auto t0 = std::chrono::steady_clock::now();
   const bool automatic = how == KappaMethod::automatic;
   const bool body_space = fs.form == Form::contact && pe.kind == PrecondKind::none &&
+                          !pe.combined &&
                           uniform_sigma(sys) && sys.body_dofs() <= kDenseMaxSize;
   if (how == KappaMethod::dense || (automatic && run.n <= kDenseMaxSize)) {
     run.s = dense_spectrum(*fs.op, *pe.P);
@@ -594,6 +707,7 @@ SpectrumRun compute_spectrum(const FormSetup &fs, const PrecondEntry &pe,
   } else {
     LanczosOptions lo;
     if (automatic) lo.max_steps = kAutoLanczosSteps;
+    if (lanczos_steps > 0) lo.max_steps = lanczos_steps;
     run.s = lanczos_spectrum(fs.form, sys, serial_exchange(), *pe.P, lo);
     run.complete = false;
     run.method = "lanczos " + std::to_string(run.s.iterations) +
@@ -613,11 +727,11 @@ SpectrumRun compute_spectrum(const FormSetup &fs, const PrecondEntry &pe,
 void write_spectrum_file(const std::string &prefix, const SpectrumRun &run)
 {
   const std::string path =
-      prefix + "_" + to_string(run.form) + "_" + to_string(run.kind) + ".csv";
+      prefix + "_" + to_string(run.form) + "_" + run.precond + ".csv";
   std::ofstream out = open_output(path);
   out.precision(17);
   out << "# fibre_analyze spectrum: form " << to_string(run.form) << ", precond "
-      << to_string(run.kind) << (run.kind == PrecondKind::none ? " (A)" : " (P^-1 A)") << ", n "
+      << run.precond << (run.precond == "none" ? " (A)" : " (P^-1 A)") << ", n "
       << run.n << "\n";
   out << "# method " << run.method
       << (run.complete ? " (all eigenvalues)" : " (Ritz values only)") << "\n";
@@ -640,7 +754,7 @@ void print_kappa_table(const std::vector<SpectrumRun> &runs)
   for (const SpectrumRun &r : runs) {
     const std::string above = r.complete ? std::to_string(r.s.r + 1) : "-";
     std::printf("  %-8s %-7s %6ld %11.4g %11.4g %11.4g %11.4g %9s %9.3g  %-34s %7.2f\n",
-                to_string(r.form), to_string(r.kind), long(r.n), r.s.kappa_e, r.s.kappa,
+                to_string(r.form), r.precond.c_str(), long(r.n), r.s.kappa_e, r.s.kappa,
                 r.s.lambda_max, r.s.lambda_r, above.c_str(), r.s.gap_ratio, r.method.c_str(),
                 r.seconds);
   }
@@ -652,7 +766,7 @@ void write_kappa_csv(std::ostream &out, const std::vector<SpectrumRun> &runs)
   out.precision(10);
   out << "form,precond,n,kappa_e,kappa,lambda_1,lambda_r,above_gap,gap_ratio,method,complete\n";
   for (const SpectrumRun &r : runs)
-    out << to_string(r.form) << ',' << to_string(r.kind) << ',' << r.n << ',' << r.s.kappa_e
+    out << to_string(r.form) << ',' << r.precond << ',' << r.n << ',' << r.s.kappa_e
         << ',' << r.s.kappa << ',' << r.s.lambda_max << ',' << r.s.lambda_r << ',' << r.s.r + 1
         << ',' << r.s.gap_ratio << ',' << r.method << ',' << (r.complete ? 1 : 0) << '\n';
 }
@@ -734,7 +848,7 @@ int analyze(const Options &opt)
     std::vector<SpectrumRun> spectra;
     for (const FormSetup &fs : forms)
       for (const PrecondEntry &pe : fs.preconds) {
-        spectra.push_back(compute_spectrum(fs, pe, sys, opt.kappa_method));
+        spectra.push_back(compute_spectrum(fs, pe, sys, opt.kappa_method, opt.lanczos_steps));
         if (!opt.spectra_prefix.empty())
           write_spectrum_file(opt.spectra_prefix, spectra.back());
       }
