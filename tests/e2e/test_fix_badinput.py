@@ -55,6 +55,10 @@ CASES = [
     ("tol_missing", "mu 0.3 tol", "expected 'tol <positive number>'", {}),
     ("pass_tol_zero", "pass_tol 0", "expected 'pass_tol <positive number>'", {}),
     ("pass_tol_missing", "pass_tol", "expected 'pass_tol <positive number>'", {}),
+    ("sweeps_negative", "sweeps -1", "expected 'sweeps <non-negative integer>', got '-1'", {}),
+    ("sweeps_real", "sweeps 2.5", "expected 'sweeps <non-negative integer>', got '2.5'", {}),
+    ("sweep_tol_zero", "sweep_tol 0", "expected 'sweep_tol <positive number>', got '0'", {}),
+    ("sweep_tol_missing", "sweep_tol", "expected 'sweep_tol <positive number>'", {}),
     ("maxiter_zero", "maxiter 0", "expected 'maxiter <positive integer>', got '0'", {}),
     ("maxiter_real", "maxiter 2.5", "expected 'maxiter <positive integer>', got '2.5'", {}),
     ("compliance_one", "compliance 1e-6", "expected 'compliance auto' or 'compliance <eps_n> "

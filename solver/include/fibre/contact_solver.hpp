@@ -39,9 +39,11 @@ struct StepOptions {
   // pass, are solved to stop.tol. 1e-4 needed 1.5x fewer Krylov iterations than 1e-6 in the
   // material scene (doc/fix_fibre_contact.md).
   double pass_tol = 1e-4;
-  // A loop that ends unsettled is finished by this many projected block-Jacobi sweeps on the
-  // full system instead of a plain projection (0: plain projection).
-  int polish_sweeps = 10;
+  // The loop's projected impulses are finished by at most this many projected Gauss-Seidel
+  // sweeps on the full system (0: none), as long as their complementarity residual exceeds
+  // sweep_tol; the sweeps stop when one moves lambda by at most sweep_tol relative to |lambda|.
+  int sweeps = 50;
+  double sweep_tol = 1e-3;
 };
 
 // Counts (released, capped) are global over all processes; so are the Krylov figures.
@@ -57,6 +59,10 @@ struct StepResult {
   bool set_settled = false;   // the active set and its caps settled (see cap_tol)
   int released = 0;         // contacts with zero impulse at the end (lambda_n < 0)
   int capped = 0;           // friction/rolling/twisting rows on their cone boundary
+  // Relative residual of the contact conditions at the final lambda (see complementarity()
+  // in contact_solver.cpp): 0 for an exact solution of the nonsmooth step.
+  double complementarity = 0;
+  int sweeps = 0;  // projected Gauss-Seidel sweeps done after the loop
   FibreStats fibres;        // of the last pass's preconditioner
   double setup_seconds = 0;  // preconditioner builds
   double solve_seconds = 0;  // linear solves (direct: analysis, factorization and solve)
