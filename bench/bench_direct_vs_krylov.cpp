@@ -103,27 +103,8 @@ struct Reference {
 
 Reference reference(const ContactSystem &sys)
 {
-  const Exchange &ex = serial_exchange();
-  std::vector<long> rows, cols;
-  std::vector<double> values;
-  upper_triplets(assemble_K(sys), rows, cols, values);
-  DistributedCholesky chol(MPI_COMM_SELF);
-  const long n = long(sys.body_dofs());
-  chol.factorize(n, rows, cols, values);
-  std::vector<long> index(n);
-  std::iota(index.begin(), index.end(), 0L);
-  auto solve = [&](const Vector &rhs) {
-    const std::vector<double> x =
-        chol.solve(index, std::vector<double>(rhs.data(), rhs.data() + rhs.size()), index);
-    return Vector(Eigen::Map<const Vector>(x.data(), Eigen::Index(x.size())));
-  };
   Reference ref;
-  const Vector rhs = body_rhs(sys, ex, sys.rhs());
-  ref.dv = solve(rhs);
-  const BodySpaceOperator K(sys, ex);
-  Vector Kdv;
-  K.apply(ref.dv, Kdv);
-  ref.dv += solve(rhs - Kdv);
+  ref.dv = refined_body_solution(sys);
   ref.norm = ref.dv.norm();
   return ref;
 }

@@ -389,29 +389,9 @@ struct Reference {
 Reference direct_reference(const ContactSystem &sys)
 {
   const Exchange &ex = serial_exchange();
-  std::vector<long> rows, cols;
-  std::vector<double> values;
-  upper_triplets(assemble_K(sys), rows, cols, values);
-  DistributedCholesky chol(MPI_COMM_SELF);
-  const long n = long(sys.body_dofs());
-  chol.factorize(n, rows, cols, values);
-  std::vector<long> index(n);
-  std::iota(index.begin(), index.end(), 0L);
-  auto solve = [&](const Vector &rhs) {
-    const std::vector<double> x =
-        chol.solve(index, std::vector<double>(rhs.data(), rhs.data() + rhs.size()), index);
-    return Vector(Eigen::Map<const Vector>(x.data(), Eigen::Index(x.size())));
-  };
   Reference ref;
-  const Vector rhs = body_rhs(sys, ex, sys.rhs());
-  ref.dv = solve(rhs);
-  const BodySpaceOperator K(sys, ex);
-  Vector Kdv;
-  K.apply(ref.dv, Kdv);
-  const Vector correction = solve(rhs - Kdv);
-  ref.dv += correction;
+  ref.dv = refined_body_solution(sys, &ref.refinement);
   ref.dv_norm = ref.dv.norm();
-  ref.refinement = ref.dv_norm > 0 ? correction.norm() / ref.dv_norm : 0.0;
   ref.lambda = direct_solve(Form::contact, sys, ex, sys.rhs(), MPI_COMM_SELF);
   const Vector dv_contact = body_from_lambda(sys, ex, ref.lambda);
   ref.contact_velocity_error = ref.dv_norm > 0 ? (dv_contact - ref.dv).norm() / ref.dv_norm

@@ -126,7 +126,7 @@ class StepSolver {
   int update_set(const Vector &lambda, const std::vector<unsigned char> &mask);
   void project(Vector &lambda, StepResult &res) const;
   std::vector<Vec6> row_scales() const;
-  void project_contact(Vector &lambda, int c) const;
+  void project_contact(double *l, int c) const;
   void sweep(Vector &lambda, const std::vector<Vec6> &scale, StepResult &res) const;
   void count_set(const Vector &lambda, StepResult &res) const;
   double complementarity(const Vector &lambda, const std::vector<Vec6> &scale) const;
@@ -363,22 +363,25 @@ std::vector<Vec6> StepSolver::row_scales() const
   return scale;
 }
 
-// lambda_n >= 0 and every cone (radius from the projected normal impulse).
-void StepSolver::project_contact(Vector &lambda, int c) const
+// lambda_n >= 0 and every cone (radius from the projected normal impulse); l points to the
+// contact's rows. Hot in the sweeps: squared norms, one square root only for a cone outside.
+void StepSolver::project_contact(double *l, int c) const
 {
-  const Eigen::Index at = base(c);
-  lambda[at] = std::max(lambda[at], 0.0);
-  if (!std::isfinite(lambda[at])) lambda[at] = 0.0;
+  l[0] = l[0] > 0 ? l[0] : 0.0;  // also NaN -> 0
+  if (!std::isfinite(l[0])) l[0] = 0.0;
   for (int k = 0; k < num_cones(rows_); ++k) {
-    const double radius = coeff(c, k) * lambda[at];
-    Eigen::Vector2d t = cone_values(lambda, at, kCones[k]);
-    const double tn = t.norm();
-    if (!(radius > 0) || !std::isfinite(tn)) {
-      t.setZero();
-    } else if (tn > radius) {
-      t *= radius / tn;
+    double *t = l + kCones[k].first;
+    const bool pair = kCones[k].size == 2;
+    const double radius = coeff(c, k) * l[0];
+    const double tn2 = t[0] * t[0] + (pair ? t[1] * t[1] : 0.0);
+    if (!(radius > 0) || !std::isfinite(tn2)) {
+      t[0] = 0.0;
+      if (pair) t[1] = 0.0;
+    } else if (tn2 > radius * radius) {
+      const double shrink = radius / std::sqrt(tn2);
+      t[0] *= shrink;
+      if (pair) t[1] *= shrink;
     }
-    set_cone(lambda, at, kCones[k], t);
   }
 }
 
@@ -395,8 +398,10 @@ void StepSolver::sweep(Vector &lambda, const std::vector<Vec6> &scale, StepResul
   for (int c = 0; c < nc_; ++c) J[c] = {jacobian_block(sys_, c, 0), jacobian_block(sys_, c, 1)};
   const Vector &inv_mass = sys_.inv_mass();
   const Vector &sigma = sys_.sigma();
+  Vector dv = velocity_change(lambda);
   for (int s = 0; s < opt_.sweeps; ++s) {
-    Vector dv = velocity_change(lambda);
+    // dv follows this process's updates; `moved` collects them for the other processes.
+    const Vector dv_start = dv;
     double norms[2] = {0, 0};  // ||change||^2, ||lambda||^2
     for (int c = 0; c < nc_; ++c) {
       const Contact &k = sys_.contacts()[c];
@@ -407,7 +412,7 @@ void StepSolver::sweep(Vector &lambda, const std::vector<Vec6> &scale, StepResul
       old.head(rows_) = lambda.segment(at, rows_);
       for (int i = 0; i < rows_; ++i)
         lambda[at + i] += (b_full_[at + i] - G_dv[i] - sigma[at + i] * old[i]) / scale[c][i];
-      project_contact(lambda, c);
+      project_contact(lambda.data() + at, c);
       Vec6 change = Vec6::Zero();
       change.head(rows_) = lambda.segment(at, rows_) - old.head(rows_);
       dv.segment<6>(ia) += inv_mass.segment<6>(ia).cwiseProduct(J[c][0].transpose() * change);
@@ -416,6 +421,11 @@ void StepSolver::sweep(Vector &lambda, const std::vector<Vec6> &scale, StepResul
       norms[0] += change.squaredNorm();
       norms[1] += lambda.segment(at, rows_).squaredNorm();
     }
+    // Every process's updates on every body: the sum of the local changes, owners and ghosts.
+    Vector moved = dv - dv_start;
+    ex_.reverse_sum(moved);
+    ex_.forward(moved);
+    dv = dv_start + moved;
     ex_.sum(norms, 2);
     ++res.sweeps;
     if (!(norms[0] > opt_.sweep_tol * opt_.sweep_tol * norms[1])) break;
@@ -457,7 +467,7 @@ double StepSolver::complementarity(const Vector &lambda, const std::vector<Vec6>
   Vector trial = lambda;
   for (int c = 0; c < nc_; ++c)
     for (int i = 0; i < rows_; ++i) trial[base(c) + i] += rho[base(c) + i] / scale[c][i];
-  for (int c = 0; c < nc_; ++c) project_contact(trial, c);
+  for (int c = 0; c < nc_; ++c) project_contact(trial.data() + base(c), c);
   double sums[2] = {(trial - lambda).squaredNorm(), lambda.squaredNorm()};
   ex_.sum(sums, 2);
   if (!(sums[1] > 0)) return sums[0] > 0 ? 1.0 : 0.0;

@@ -79,4 +79,9 @@ class DistributedCholesky {
 Vector direct_solve(Form form, const ContactSystem &sys, const Exchange &ex, const Vector &b,
                     MPI_Comm comm);
 
+// The reference velocity change of tools and benchmarks (one process): dv* solving
+// K dv = G^T Sigma^-1 rhs with MUMPS, plus one step of iterative refinement with the same
+// factors. `refinement` (optional) receives ||correction|| / ||dv*||.
+Vector refined_body_solution(const ContactSystem &sys, double *refinement = nullptr);
+
 }  // namespace fibre
