@@ -308,6 +308,9 @@ def load_method(a, scene, method, n, tag=None):
     res["dt"] = float(dtv[1]) if dtv else float("nan")
     if "f_fc[7]" in blocks[-1]:
         res["fc_overlap"] = float(max(b["f_fc[7]"].max() for b in blocks))
+    if "f_fc[13]" in blocks[-1]:
+        res["fc_compl"] = float(max(b["f_fc[13]"].max() for b in blocks))
+        res["fc_iters"] = float(np.mean(np.concatenate([b["f_fc[1]"] for b in blocks])))
     if scene == "material":
         final = read_frames(os.path.join(d, "pile.%s.%d.dump" % (method, n)))[-1][1]
         res["final"] = final
@@ -381,6 +384,11 @@ def table(scene, n, R):
     row("max overlap / mean diameter", "overlap_rel", "%.2g", rel=False)
     if "fc_overlap" in fib:
         rows.append("| max overlap, f_fc[7] every thermo line (m) | - | %.3g | |" % fib["fc_overlap"])
+    if "fc_compl" in fib:
+        rows.append("| complementarity residual, f_fc[13], max over thermo lines | - | %.2g | |"
+                    % fib["fc_compl"])
+        rows.append("| Krylov iterations per step, f_fc[1], mean over thermo lines | - | %.0f | |"
+                    % fib["fc_iters"])
     row("simulated time (s)", "sim", "%.2f", rel=False)
     row("wall-clock time (s)", "wall", "%.1f", rel=False)
     row("wall-clock per simulated second (s/s)", "wall_per_s", "%.2f", rel=False)
