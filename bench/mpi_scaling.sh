@@ -49,18 +49,10 @@ done
 export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 OMP_NUM_THREADS=1
 cores=$(getconf _NPROCESSORS_ONLN)
 mkdir -p "$work"
-cp "$src/examples/$deck/"*."$deck" "$work/"
 cd "$work"
-# Timing columns instead of the deck's fibre_thermo, and per-step averages of the fix's
-# timings over the whole run, printed at the end.
-sed -i 's/^variable  *fibre_thermo string .*/variable  fibre_thermo string "f_fc[1] f_fc[3] f_fc[8] f_fc[9]"/' "in.$deck"
-sed -i "s/^include  *run\.$deck/fix       fc_time all ave\/time 1 1 1 f_fc[8] f_fc[9] ave running\n&/" "in.$deck"
-echo 'print "fibre_timing setup_per_step $(f_fc_time[1]) solve_per_step $(f_fc_time[2])"' >> "in.$deck"
-case $deck in
-  material) timevar="-var tend $tend" ;;
-  silo) timevar="-var tfill $tend -var tflow 0" ;;
-  *) timevar="" ;;
-esac
+. "$src/bench/common.sh"
+prepare_fibre_deck "$src" "$deck"
+timevar=$(time_vars "$deck" "$tend")
 
 echo "mpi_scaling: $(date -u '+%Y-%m-%d %H:%M UTC'), $(hostname), $cores cores;" \
      "deck $deck N $N tend $tend, extra '$extra', mpirun flags '$mpirun_flags'"

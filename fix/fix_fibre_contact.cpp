@@ -104,13 +104,13 @@ FixFibreContact::FixFibreContact(LAMMPS *lmp, int narg, char **arg) : Fix(lmp, n
   opt_.precond.kind = fibre::PrecondKind::tree;
   opt_.precond.weight = fibre::EdgeWeight::z;
   // The projected Gauss-Seidel sweeps finish every step to a complementarity residual of
-  // sweep_tol; linear solves tighter than tol 1e-4 and more than 2 active-set passes bought no
-  // accuracy in the material and silo scenes, only time.
+  // sweep_tol; linear solves tighter than tol 1e-4 and more than one active-set pass bought no
+  // accuracy in the material and silo scenes, only time (doc page, "Why both").
   opt_.stop.tol = 1e-4;
   opt_.pass_tol = 1e-3;
   opt_.stop.max_iter = 200;
   opt_.friction = fibre::FrictionParams{};
-  opt_.active_set_max = 2;
+  opt_.active_set_max = 1;
   opt_.sweeps = 50;
   opt_.sweep_tol = 1e-3;
 
@@ -176,6 +176,15 @@ double FixFibreContact::parse_number(int narg, char **arg, int iarg, const std::
   return value;
 }
 
+long FixFibreContact::parse_integer(int narg, char **arg, int iarg, const std::string &expected,
+                                    long lo, long hi)
+{
+  if (iarg >= narg) illegal(expected);
+  long value = 0;
+  if (!to_long(arg[iarg], value) || value < lo || value > hi) illegal(expected, arg[iarg]);
+  return value;
+}
+
 void FixFibreContact::parse_args(int narg, char **arg)
 {
   int iarg = 3;
@@ -217,10 +226,7 @@ void FixFibreContact::parse_args(int narg, char **arg)
       iarg += 2;
     } else if (key == "maxiter") {
       const std::string e = "'maxiter <positive integer>'";
-      long v = 0;
-      if (!val) illegal(e);
-      if (!to_long(val, v) || v < 1 || v > 100000000) illegal(e, val);
-      opt_.stop.max_iter = static_cast<int>(v);
+      opt_.stop.max_iter = static_cast<int>(parse_integer(narg, arg, iarg + 1, e, 1, 100000000));
       iarg += 2;
     } else if (key == "compliance") {
       const std::string e = "'compliance auto' or 'compliance <eps_n> <eps_t>' (positive numbers)";
@@ -261,17 +267,11 @@ void FixFibreContact::parse_args(int narg, char **arg)
       iarg += 2;
     } else if (key == "active_set") {
       const std::string e = "'active_set <positive integer>'";
-      long v = 0;
-      if (!val) illegal(e);
-      if (!to_long(val, v) || v < 1 || v > 1000) illegal(e, val);
-      opt_.active_set_max = static_cast<int>(v);
+      opt_.active_set_max = static_cast<int>(parse_integer(narg, arg, iarg + 1, e, 1, 1000));
       iarg += 2;
     } else if (key == "sweeps") {
       const std::string e = "'sweeps <non-negative integer>'";
-      long v = 0;
-      if (!val) illegal(e);
-      if (!to_long(val, v) || v < 0 || v > 100000) illegal(e, val);
-      opt_.sweeps = static_cast<int>(v);
+      opt_.sweeps = static_cast<int>(parse_integer(narg, arg, iarg + 1, e, 0, 100000));
       iarg += 2;
     } else if (key == "sweep_tol") {
       const std::string e = "'sweep_tol <positive number>'";

@@ -81,6 +81,8 @@ class FixFibreContact : public Fix {
   void parse_args(int narg, char **arg);
   [[noreturn]] void illegal(const std::string &expected, const char *got = nullptr);
   double parse_number(int narg, char **arg, int iarg, const std::string &expected);
+  long parse_integer(int narg, char **arg, int iarg, const std::string &expected, long lo,
+                     long hi);
   void check_pair_style(bool at_init);
 
   void build_bodies(std::vector<fibre::Body> &bodies);
