@@ -62,15 +62,18 @@ done
 awk -v f="${loop[fibre]}" -v n="${loop[native]}" 'BEGIN {
   printf "  fibre_contact / native speed: %.2fx (target >= 5x at 5000 bodies)\n", n / f }'
 echo "  (LAMMPS wall-clock loop times: on a shared machine, repeat and compare ratios)"
-tm=$(sed -n 's/^fibre_timing setup_per_step \([^ ]*\) solve_per_step \([^ ]*\)/\1 \2/p' log.fibre | tail -1)
+tm=$(sed -n 's/^fibre_timing setup_per_step \([^ ]*\) solve_per_step \([^ ]*\) sweep_per_step \([^ ]*\)/\1 \2 \3/p' log.fibre | tail -1)
 modify=$(awk '$1 == "Modify" && $2 == "|" { m += $5 } END { print m }' log.fibre)  # avg times, summed
 awk -v tm="$tm" -v st="${steps[fibre]}" -v l="${loop[fibre]}" -v m="$modify" 'BEGIN {
-  split(tm, t, " "); setup = t[1] * st; solve = t[2] * st;
+  split(tm, t, " "); setup = t[1] * st; solve = t[2] * st; sweep = t[3] * st;
   printf "  fibre run, where the time goes (s, %% of loop):\n";
   printf "    preconditioner setup  %8.2f %5.1f%%\n", setup, 100 * setup / l;
   printf "    linear solves         %8.2f %5.1f%%\n", solve, 100 * solve / l;
+  printf "    Gauss-Seidel sweeps   %8.2f %5.1f%%  (with the complementarity residuals)\n",
+    sweep, 100 * sweep / l;
+  rest = m - setup - solve - sweep;
   printf "    rest of the fix       %8.2f %5.1f%%  (detection, system build, active set, update)\n",
-    m - setup - solve, 100 * (m - setup - solve) / l;
+    rest, 100 * rest / l;
   printf "    outside the fix       %8.2f %5.1f%%  (neighbour lists, comm, output, pour)\n",
     l - m, 100 * (l - m) / l }'
 echo "  LAMMPS breakdown of the fibre run (one table per run command):"

@@ -56,8 +56,8 @@ timevar=$(time_vars "$deck" "$tend")
 
 echo "mpi_scaling: $(date -u '+%Y-%m-%d %H:%M UTC'), $(hostname), $cores cores;" \
      "deck $deck N $N tend $tend, extra '$extra', mpirun flags '$mpirun_flags'"
-printf '%4s %10s %8s %8s %10s %10s %8s %8s %8s %8s %8s\n' np loop_s speedup eff \
-  setup_ms/st solve_ms/st pair% neigh% comm% modify% other%
+printf '%4s %10s %8s %8s %10s %10s %10s %8s %8s %8s %8s %8s\n' np loop_s speedup eff \
+  setup_ms/st solve_ms/st sweep_ms/st pair% neigh% comm% modify% other%
 t1=""
 for np in $nps; do
   over=""
@@ -68,7 +68,7 @@ for np in $nps; do
     -log "$log" -screen none > "out.np$np" 2>&1 || { echo "np $np failed, see $work/out.np$np"; continue; }
   loop=$(sed -n 's/^Loop time of \([0-9.e+-]*\) on .*/\1/p' "$log" | tail -1)
   steps=$(sed -n 's/.* for \([0-9]*\) steps with .*/\1/p' "$log" | tail -1)
-  timing=$(sed -n 's/^fibre_timing setup_per_step \([^ ]*\) solve_per_step \([^ ]*\)/\1 \2/p' "$log" | tail -1)
+  timing=$(sed -n 's/^fibre_timing setup_per_step \([^ ]*\) solve_per_step \([^ ]*\) sweep_per_step \([^ ]*\)/\1 \2 \3/p' "$log" | tail -1)
   pct() { awk -v k="$1" '$1 == k && $2 == "|" { print $NF }' "$log" | tail -1; }
   [ -z "$t1" ] && t1=$loop && p1=$np
   awk -v np="$np" -v loop="$loop" -v t1="$t1" -v p1="$p1" -v tm="$timing" \
@@ -76,8 +76,8 @@ for np in $nps; do
       -v modify="$(pct Modify)" -v other="$(pct Other)" 'BEGIN {
     split(tm, t, " ");
     s = t1 / loop; e = s * p1 / np;
-    printf "%4d %10.2f %8.2f %7.0f%% %10.2f %10.2f %8s %8s %8s %8s %8s\n", np, loop, s, 100 * e,
-      1e3 * t[1], 1e3 * t[2], pair, neigh, comm, modify, other }'
+    printf "%4d %10.2f %8.2f %7.0f%% %10.2f %10.2f %10.2f %8s %8s %8s %8s %8s\n", np, loop, s,
+      100 * e, 1e3 * t[1], 1e3 * t[2], 1e3 * t[3], pair, neigh, comm, modify, other }'
   echo "     ($steps steps; LAMMPS log $work/$log)"
 done
 echo "eff = T(first) * np(first) / (np * T): parallel efficiency of the loop time"

@@ -41,7 +41,7 @@ namespace {
 
 constexpr int kLocalColumns = 8;
 constexpr int kWallKeyStride = 1024;  // wall key = wall index * stride + sub-wall + 1
-constexpr double kRestartFormat = 2.0;  // 2: 14 global values
+constexpr double kRestartFormat = 2.0;  // 2: 15 global values
 // pairs closer than this fraction of the smaller radius are always contacts
 constexpr double kContactMargin = 0.01;
 
@@ -858,10 +858,11 @@ void FixFibreContact::report_solve(const fibre::StepResult &res)
   MPI_Allreduce(MPI_IN_PLACE, sums, 3, MPI_DOUBLE, MPI_SUM, world);
   stats_[V_FIBRES] = sums[0];
   stats_[V_FIBRE_FRACTION] = sums[2] > 0 ? sums[1] / sums[2] : 0.0;
-  double times[2] = {res.setup_seconds, res.solve_seconds};
-  MPI_Allreduce(MPI_IN_PLACE, times, 2, MPI_DOUBLE, MPI_MAX, world);
+  double times[3] = {res.setup_seconds, res.solve_seconds, res.sweep_seconds};
+  MPI_Allreduce(MPI_IN_PLACE, times, 3, MPI_DOUBLE, MPI_MAX, world);
   stats_[V_SETUP] = times[0];
   stats_[V_SOLVE] = times[1];
+  stats_[V_SWEEP_TIME] = times[2];
 
   if (!res.converged) {
     ++nonconverged_total_;

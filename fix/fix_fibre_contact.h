@@ -128,7 +128,7 @@ class FixFibreContact : public Fix {
   // statistics (global vector)
   enum {
     V_ITER = 0, V_RESID, V_CONTACTS, V_FIBRES, V_FIBRE_FRACTION, V_PASSES, V_OVERLAP,
-    V_SETUP, V_SOLVE, V_CONVERGED, V_WALL_CONTACTS, V_NONCONVERGED, V_COMPLEMENTARITY, V_SWEEPS, V_SIZE
+    V_SETUP, V_SOLVE, V_CONVERGED, V_WALL_CONTACTS, V_NONCONVERGED, V_COMPLEMENTARITY, V_SWEEPS, V_SWEEP_TIME, V_SIZE
   };
   double stats_[V_SIZE] = {};
   bigint nonconverged_total_ = 0;

@@ -540,6 +540,7 @@ StepResult StepSolver::run(const Vector *warm)
   // compressive ones and kick the bodies between them: 29 m/s in one silo step.)
   project(lambda, res);
   if (last_reason_ != StopReason::non_finite) {
+    const auto t_sweep = Clock::now();
     const std::vector<Vec6> scale = row_scales();
     res.complementarity = complementarity(lambda, scale);
     if (opt_.sweeps > 0 && res.complementarity > opt_.sweep_tol) {
@@ -547,6 +548,7 @@ StepResult StepSolver::run(const Vector *warm)
       count_set(lambda, res);
       res.complementarity = complementarity(lambda, scale);
     }
+    res.sweep_seconds = seconds_since(t_sweep);
   }
   sys_.set_rhs(b_full_);
   res.dv = body_from_lambda(sys_, ex_, lambda);

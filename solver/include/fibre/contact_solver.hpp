@@ -66,6 +66,7 @@ struct StepResult {
   FibreStats fibres;        // of the last pass's preconditioner
   double setup_seconds = 0;  // preconditioner builds
   double solve_seconds = 0;  // linear solves (direct: analysis, factorization and solve)
+  double sweep_seconds = 0;  // projected Gauss-Seidel sweeps and the residuals around them
   double total_seconds = 0;  // the whole call
 };
 
