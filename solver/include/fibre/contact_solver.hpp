@@ -1,6 +1,7 @@
-// One SPOOK step's contact solve: preconditioner setup, linear solve in either form, and the
+// One SPOOK step's contact solve: preconditioner setup, linear solve in either form, the
 // bounded active-set loop for lambda_n >= 0, Coulomb friction and rolling/twisting
-// resistance (design.md section 2). This is what the LAMMPS fix calls every step.
+// resistance (design.md section 2), and projected Gauss-Seidel sweeps that finish it. This is
+// what the LAMMPS fix calls every step.
 #pragma once
 
 #include <mpi.h>
@@ -86,8 +87,10 @@ struct StepResult {
 // that leave their radius are capped along the solved direction. Rows outside the solve are
 // judged by their trial impulse (lambda + rho / sigma with rho the row's residual): released
 // contacts that would press again come back, capped cones that would stick are freed, at
-// most 3 times per contact and cone in a step (anti-cycling). A final projection then makes
-// lambda feasible (lambda_n >= 0, every cone).
+// most 3 times per contact and cone in a step (anti-cycling). A projection then makes lambda
+// feasible (lambda_n >= 0, every cone), and projected Gauss-Seidel sweeps follow while the
+// complementarity residual exceeds sweep_tol: in piles the set rarely settles, and the sweeps
+// are what makes the step's friction hold (StepResult::complementarity).
 StepResult solve_step(ContactSystem &sys, const Exchange &ex, const StepOptions &opt,
                       const Vector *warm, MPI_Comm comm);
 
