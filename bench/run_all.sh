@@ -34,5 +34,7 @@ fi
 if [ -z "${SKIP_E2E:-}" ]; then
   "$src/bench/e2e_speed.sh" --deck material --N 1400 --tend 3.0 > "$out/e2e_material.txt" 2>&1
   "$src/bench/e2e_speed.sh" --deck silo --N 1400 --tend 3.0 > "$out/e2e_silo.txt" 2>&1
+  "$src/bench/e2e_speed.sh" --deck silo --N 5000 --tend 2.0 --work /tmp/fibre_e2e_s5000 > "$out/e2e_silo5000.txt" 2>&1
+  "$src/bench/e2e_speed.sh" --deck material --N 5000 --tend 8.0 --work /tmp/fibre_e2e_m5000 > "$out/e2e_material5000.txt" 2>&1
 fi
 echo "figures in $out"
