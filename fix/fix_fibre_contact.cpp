@@ -176,6 +176,13 @@ double FixFibreContact::parse_number(int narg, char **arg, int iarg, const std::
   return value;
 }
 
+double FixFibreContact::parse_positive(int narg, char **arg, int iarg, const std::string &expected)
+{
+  const double value = parse_number(narg, arg, iarg, expected);
+  if (!(value > 0.0)) illegal(expected, arg[iarg]);
+  return value;
+}
+
 long FixFibreContact::parse_integer(int narg, char **arg, int iarg, const std::string &expected,
                                     long lo, long hi)
 {
@@ -214,15 +221,11 @@ void FixFibreContact::parse_args(int narg, char **arg)
       iarg += 2;
     } else if (key == "tol") {
       const std::string e = "'tol <positive number>'";
-      const double v = parse_number(narg, arg, iarg + 1, e);
-      if (!(v > 0.0)) illegal(e, val);
-      opt_.stop.tol = v;
+      opt_.stop.tol = parse_positive(narg, arg, iarg + 1, e);
       iarg += 2;
     } else if (key == "pass_tol") {
       const std::string e = "'pass_tol <positive number>'";
-      const double v = parse_number(narg, arg, iarg + 1, e);
-      if (!(v > 0.0)) illegal(e, val);
-      opt_.pass_tol = v;
+      opt_.pass_tol = parse_positive(narg, arg, iarg + 1, e);
       iarg += 2;
     } else if (key == "maxiter") {
       const std::string e = "'maxiter <positive integer>'";
@@ -235,10 +238,8 @@ void FixFibreContact::parse_args(int narg, char **arg)
         compliance_auto_ = true;
         iarg += 2;
       } else {
-        const double en = parse_number(narg, arg, iarg + 1, e);
-        const double et = parse_number(narg, arg, iarg + 2, e);
-        if (!(en > 0.0)) illegal(e, arg[iarg + 1]);
-        if (!(et > 0.0)) illegal(e, arg[iarg + 2]);
+        const double en = parse_positive(narg, arg, iarg + 1, e);
+        const double et = parse_positive(narg, arg, iarg + 2, e);
         compliance_auto_ = false;
         compliance_n_ = en;
         compliance_t_ = et;
@@ -246,9 +247,7 @@ void FixFibreContact::parse_args(int narg, char **arg)
       }
     } else if (key == "damping") {
       const std::string e = "'damping <positive number of steps>'";
-      const double v = parse_number(narg, arg, iarg + 1, e);
-      if (!(v > 0.0)) illegal(e, val);
-      damping_ = v;
+      damping_ = parse_positive(narg, arg, iarg + 1, e);
       iarg += 2;
     } else if (key == "mu" || key == "mu_roll" || key == "mu_twist") {
       const std::string e = "'" + key + " <non-negative number>'";
@@ -275,9 +274,7 @@ void FixFibreContact::parse_args(int narg, char **arg)
       iarg += 2;
     } else if (key == "sweep_tol") {
       const std::string e = "'sweep_tol <positive number>'";
-      const double v = parse_number(narg, arg, iarg + 1, e);
-      if (!(v > 0.0)) illegal(e, val);
-      opt_.sweep_tol = v;
+      opt_.sweep_tol = parse_positive(narg, arg, iarg + 1, e);
       iarg += 2;
     } else if (key == "wall") {
       const std::string e =

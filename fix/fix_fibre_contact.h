@@ -81,6 +81,7 @@ class FixFibreContact : public Fix {
   void parse_args(int narg, char **arg);
   [[noreturn]] void illegal(const std::string &expected, const char *got = nullptr);
   double parse_number(int narg, char **arg, int iarg, const std::string &expected);
+  double parse_positive(int narg, char **arg, int iarg, const std::string &expected);
   long parse_integer(int narg, char **arg, int iarg, const std::string &expected, long lo,
                      long hi);
   void check_pair_style(bool at_init);
@@ -128,7 +129,8 @@ class FixFibreContact : public Fix {
   // statistics (global vector)
   enum {
     V_ITER = 0, V_RESID, V_CONTACTS, V_FIBRES, V_FIBRE_FRACTION, V_PASSES, V_OVERLAP,
-    V_SETUP, V_SOLVE, V_CONVERGED, V_WALL_CONTACTS, V_NONCONVERGED, V_COMPLEMENTARITY, V_SWEEPS, V_SWEEP_TIME, V_SIZE
+    V_SETUP, V_SOLVE, V_CONVERGED, V_WALL_CONTACTS, V_NONCONVERGED, V_COMPLEMENTARITY, V_SWEEPS,
+    V_SWEEP_TIME, V_SIZE
   };
   double stats_[V_SIZE] = {};
   bigint nonconverged_total_ = 0;

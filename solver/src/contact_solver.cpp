@@ -124,7 +124,7 @@ class StepSolver {
   Vector linear_solve(const Vector &b, const Vector &warm, const StopControl &stop, bool tight,
                       StepResult &res);
   int update_set(const Vector &lambda, const std::vector<unsigned char> &mask);
-  void project(Vector &lambda, StepResult &res) const;
+  void project(Vector &lambda) const;
   std::vector<Vec6> row_scales() const;
   void project_contact(double *l, int c) const;
   void sweep(Vector &lambda, const std::vector<Vec6> &scale, StepResult &res) const;
@@ -309,16 +309,14 @@ int StepSolver::update_set(const Vector &lambda, const std::vector<unsigned char
   return changes;
 }
 
-// Final projection: lambda_n >= 0 and every cone, capped cones on their boundary along the
-// slip direction with the final normal impulse.
-void StepSolver::project(Vector &lambda, StepResult &res) const
+// Projection: lambda_n >= 0 and every cone, capped cones on their boundary along the slip
+// direction with the final normal impulse.
+void StepSolver::project(Vector &lambda) const
 {
-  double counts[2] = {0, 0};  // released contacts, rows on a cone boundary
   for (int c = 0; c < nc_; ++c) {
     const double ln = lambda[base(c)];
     if (state_[c].released || !(ln > 0)) {
       lambda.segment(base(c), rows_).setZero();
-      counts[0] += 1;
       continue;
     }
     for (int k = 0; k < num_cones(rows_); ++k) {
@@ -333,13 +331,9 @@ void StepSolver::project(Vector &lambda, StepResult &res) const
       } else {
         continue;
       }
-      if (radius > 0) counts[1] += cone.size;
       set_cone(lambda, base(c), cone, t);
     }
   }
-  ex_.sum(counts, 2);
-  res.released = static_cast<int>(counts[0]);
-  res.capped = static_cast<int>(counts[1]);
 }
 
 // Per-row scaling of the projected maps below: A_ii for the normal row and the largest A_ii
@@ -399,9 +393,10 @@ void StepSolver::sweep(Vector &lambda, const std::vector<Vec6> &scale, StepResul
   const Vector &inv_mass = sys_.inv_mass();
   const Vector &sigma = sys_.sigma();
   Vector dv = velocity_change(lambda);
+  Vector dv_start, moved;  // reused by every sweep
   for (int s = 0; s < opt_.sweeps; ++s) {
     // dv follows this process's updates; `moved` collects them for the other processes.
-    const Vector dv_start = dv;
+    dv_start = dv;
     double norms[2] = {0, 0};  // ||change||^2, ||lambda||^2
     for (int c = 0; c < nc_; ++c) {
       const Contact &k = sys_.contacts()[c];
@@ -422,7 +417,7 @@ void StepSolver::sweep(Vector &lambda, const std::vector<Vec6> &scale, StepResul
       norms[1] += lambda.segment(at, rows_).squaredNorm();
     }
     // Every process's updates on every body: the sum of the local changes, owners and ghosts.
-    Vector moved = dv - dv_start;
+    moved = dv - dv_start;
     ex_.reverse_sum(moved);
     ex_.forward(moved);
     dv = dv_start + moved;
@@ -538,18 +533,18 @@ StepResult StepSolver::run(const Vector *warm)
   // Feasible impulses, then projected Gauss-Seidel sweeps while they are not accurate enough.
   // (Projecting an unsettled pass alone could zero a tensile impulse that balances large
   // compressive ones and kick the bodies between them: 29 m/s in one silo step.)
-  project(lambda, res);
+  project(lambda);
   if (last_reason_ != StopReason::non_finite) {
     const auto t_sweep = Clock::now();
     const std::vector<Vec6> scale = row_scales();
     res.complementarity = complementarity(lambda, scale);
     if (opt_.sweeps > 0 && res.complementarity > opt_.sweep_tol) {
       sweep(lambda, scale, res);
-      count_set(lambda, res);
       res.complementarity = complementarity(lambda, scale);
     }
     res.sweep_seconds = seconds_since(t_sweep);
   }
+  count_set(lambda, res);
   sys_.set_rhs(b_full_);
   res.dv = body_from_lambda(sys_, ex_, lambda);
   res.lambda = std::move(lambda);
