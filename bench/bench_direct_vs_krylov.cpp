@@ -46,7 +46,7 @@
 #include "fibre/assembly.hpp"
 #include "fibre/direct.hpp"
 #include "fibre/krylov.hpp"
-#include "fibre/preconditioners.hpp"
+#include "fibre/preconditioner_family.hpp"
 #include "fibre/system_io.hpp"
 
 using namespace fibre;
@@ -280,8 +280,8 @@ void run_case(const std::string &name, const ContactSystem &sys, int repeat, boo
   rows.push_back(eigen_row(sys, ref, Form::body, repeat));
   rows.push_back(eigen_row(sys, ref, Form::contact, repeat));
   const std::vector<Method> methods =
-      all_methods ? std::vector<Method>{Method::uzawa, Method::cr, Method::minres}
-                  : std::vector<Method>{Method::uzawa};
+      all_methods ? std::vector<Method>{Method::cg, Method::cr, Method::minres}
+                  : std::vector<Method>{Method::cg};
   for (Form form : {Form::body, Form::contact})
     for (PrecondKind kind : {PrecondKind::tree, PrecondKind::fibre, PrecondKind::block})
       for (Method m : methods) {

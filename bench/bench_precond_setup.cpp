@@ -7,7 +7,7 @@
 #include <map>
 #include <memory>
 
-#include "fibre/preconditioners.hpp"
+#include "fibre/preconditioner_family.hpp"
 #include "fibre/scenes.hpp"
 
 using namespace fibre;

@@ -15,7 +15,7 @@
 
 #include "bench_scenes.hpp"
 #include "fibre/operators.hpp"
-#include "fibre/preconditioners.hpp"
+#include "fibre/preconditioner_family.hpp"
 
 using namespace fibre;
 

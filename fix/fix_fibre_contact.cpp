@@ -100,7 +100,7 @@ FixFibreContact::FixFibreContact(LAMMPS *lmp, int narg, char **arg) : Fix(lmp, n
 
   // defaults by measurement (doc/fix_fibre_contact.md, "Solvers")
   opt_.form = fibre::Form::body;
-  opt_.solver = fibre::SolverKind::uzawa;
+  opt_.solver = fibre::Method::cg;
   opt_.precond.kind = fibre::PrecondKind::tree;
   opt_.precond.weight = fibre::EdgeWeight::z;
   // The projected Gauss-Seidel sweeps finish every step to a complementarity residual of
@@ -202,22 +202,22 @@ void FixFibreContact::parse_args(int narg, char **arg)
     if (key == "form") {
       const std::string e = "'form body|contact'";
       if (!val) illegal(e);
-      if (!fibre::parse_form(val, opt_.form)) illegal(e, val);
+      if (!fibre::parse(val, opt_.form)) illegal(e, val);
       iarg += 2;
     } else if (key == "solver") {
       const std::string e = "'solver uzawa|cr|minres|direct'";
       if (!val) illegal(e);
-      if (!fibre::parse_solver(val, opt_.solver)) illegal(e, val);
+      if (!fibre::parse(val, opt_.solver)) illegal(e, val);
       iarg += 2;
     } else if (key == "precond") {
       const std::string e = "'precond none|jacobi|block|fibre|tree'";
       if (!val) illegal(e);
-      if (!fibre::parse_precond(val, opt_.precond.kind)) illegal(e, val);
+      if (!fibre::parse(val, opt_.precond.kind)) illegal(e, val);
       iarg += 2;
     } else if (key == "weight") {
       const std::string e = "'weight z|straight|impulse'";
       if (!val) illegal(e);
-      if (!fibre::parse_weight(val, opt_.precond.weight)) illegal(e, val);
+      if (!fibre::parse(val, opt_.precond.weight)) illegal(e, val);
       iarg += 2;
     } else if (key == "tol") {
       const std::string e = "'tol <positive number>'";

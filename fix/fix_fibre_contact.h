@@ -11,7 +11,7 @@
 #include <string>
 #include <vector>
 
-#include "fibre/contact_solver.hpp"
+#include "fibre/step_solver.hpp"
 #include "fix.h"
 
 namespace fibre_lmp {

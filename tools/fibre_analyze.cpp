@@ -39,7 +39,7 @@
 #include "fibre/assembly.hpp"
 #include "fibre/direct.hpp"
 #include "fibre/krylov.hpp"
-#include "fibre/preconditioners.hpp"
+#include "fibre/preconditioner_family.hpp"
 #include "fibre/spectra.hpp"
 #include "fibre/system_io.hpp"
 
@@ -69,7 +69,7 @@ A lambda = b (A = G M^-1 G^T + Sigma) and/or the body form K dv = G^T Sigma^-1 b
 
 options:
   --form contact|body|both     the form(s) to solve (default both)
-  --methods LIST               comma-separated, from uzawa,cr,minres (default all)
+  --methods LIST               comma-separated, from cg,cr,minres (uzawa: cg) (default all)
   --precond LIST               comma-separated, from none,jacobi,block,fibre,tree (default all)
   --weight z|straight|impulse  edge weight of the fibre and tree preconditioners (default z);
                                impulse uses the normal impulses of the direct solution
@@ -111,7 +111,7 @@ enum class KappaMethod { automatic, dense, lanczos };
 struct Options {
   std::string system_file;
   std::vector<Form> forms{Form::contact, Form::body};
-  std::vector<Method> methods{Method::uzawa, Method::cr, Method::minres};
+  std::vector<Method> methods{Method::cg, Method::cr, Method::minres};
   std::vector<PrecondKind> preconds{PrecondKind::none, PrecondKind::jacobi, PrecondKind::block,
                                     PrecondKind::fibre, PrecondKind::tree};
   EdgeWeight weight = EdgeWeight::z;
@@ -143,15 +143,15 @@ std::vector<std::string> split_list(const std::string &option, const std::string
   return items;
 }
 
-// Parses a comma-separated list with `parse`, dropping repeats and keeping the order.
-template <class T, class Parse>
-std::vector<T> parse_list(const std::string &option, const std::string &value, Parse parse,
+// Parses a comma-separated list of T's names, dropping repeats and keeping the order.
+template <class T, class Valid>
+std::vector<T> parse_list(const std::string &option, const std::string &value, Valid valid,
                           const char *allowed)
 {
   std::vector<T> out;
   for (const std::string &item : split_list(option, value)) {
     T v{};
-    if (!parse(item, v))
+    if (!fibre::parse(item, v) || !valid(v))
       throw UsageError(option + ": unknown entry '" + item + "' (allowed: " + allowed + ")");
     if (std::find(out.begin(), out.end(), v) == out.end()) out.push_back(v);
   }
@@ -215,17 +215,17 @@ Options parse_args(int argc, char **argv)
         opt.forms = {Form::contact, Form::body};
       } else {
         Form f;
-        if (!parse_form(value, f))
+        if (!parse(value, f))
           throw UsageError("--form: unknown form '" + value + "' (allowed: contact, body, both)");
         opt.forms = {f};
       }
     } else if (arg == "--methods") {
-      opt.methods = parse_list<Method>(arg, value, parse_method, "uzawa, cr, minres");
+      opt.methods = parse_list<Method>(arg, value, is_krylov, "cg, cr, minres");
     } else if (arg == "--precond") {
-      opt.preconds = parse_list<PrecondKind>(arg, value, parse_precond,
+      opt.preconds = parse_list<PrecondKind>(arg, value, [](PrecondKind) { return true; },
                                              "none, jacobi, block, fibre, tree");
     } else if (arg == "--weight") {
-      if (!parse_weight(value, opt.weight))
+      if (!parse(value, opt.weight))
         throw UsageError("--weight: unknown weight '" + value +
                          "' (allowed: z, straight, impulse)");
     } else if (arg == "--maxiter") {

@@ -7,29 +7,6 @@
 
 namespace fibre {
 
-const char *to_string(EdgeWeight w)
-{
-  switch (w) {
-  case EdgeWeight::z:
-    return "z";
-  case EdgeWeight::straight:
-    return "straight";
-  case EdgeWeight::impulse:
-    return "impulse";
-  }
-  return "?";
-}
-
-bool parse_weight(const std::string &s, EdgeWeight &w)
-{
-  for (EdgeWeight c : {EdgeWeight::z, EdgeWeight::straight, EdgeWeight::impulse})
-    if (s == to_string(c)) {
-      w = c;
-      return true;
-    }
-  return false;
-}
-
 ContactGraph contact_graph(const ContactSystem &sys, bool include_ghosts)
 {
   const int nb = sys.num_bodies(), nc = sys.num_contacts();
@@ -205,50 +182,6 @@ Fibres build_fibres(const ContactSystem &sys, EdgeWeight weight, const Vector *i
 {
   check_impulses(sys, weight, impulses);
   return greedy_fibres(sys, contact_graph(sys, include_ghosts), WalkWeight(sys, weight, impulses));
-}
-
-Relabelling relabel_for_fibres(const ContactSystem &sys, const Fibres &fibres)
-{
-  const int nb = sys.num_bodies(), nc = sys.num_contacts(), owned = sys.num_owned_bodies();
-  Relabelling r;
-  r.new_body.assign(nb, -1);
-  r.new_contact.assign(nc, -1);
-  int next_owned = 0, next_ghost = owned;
-  auto label_body = [&](int i) {
-    if (r.new_body[i] < 0) r.new_body[i] = i < owned ? next_owned++ : next_ghost++;
-  };
-  for (int i : fibres.bodies) label_body(i);
-  for (int i = 0; i < nb; ++i) label_body(i);
-  int next = 0;
-  for (int c : fibres.contacts) r.new_contact[c] = next++;
-  for (int c = 0; c < nc; ++c)
-    if (r.new_contact[c] < 0) r.new_contact[c] = next++;
-  return r;
-}
-
-Fibres relabelled(const Fibres &fibres, const Relabelling &r)
-{
-  Fibres out = fibres;
-  for (int &i : out.bodies) i = r.new_body[i];
-  for (int &c : out.contacts) c = r.new_contact[c];
-  return out;
-}
-
-Relabelling relabel_system(ContactSystem &sys, Fibres &fibres)
-{
-  Relabelling r = relabel_for_fibres(sys, fibres);
-  sys.permute(r.new_body, r.new_contact);
-  fibres = relabelled(fibres, r);
-  return r;
-}
-
-Vector relabel_contact_vector(const Relabelling &r, int rows, const Vector &x)
-{
-  Vector y(x.size());
-  for (std::size_t c = 0; c < r.new_contact.size(); ++c)
-    y.segment(Eigen::Index(rows) * r.new_contact[c], rows) =
-        x.segment(Eigen::Index(rows) * Eigen::Index(c), rows);
-  return y;
 }
 
 namespace {

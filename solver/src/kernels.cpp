@@ -221,28 +221,16 @@ void gt_apply(const ContactSystem &sys, const Vector &lambda, Vector &out)
   dispatch<GtRun>(sys, lambda.data(), out.data());
 }
 
-void schur_apply(const ContactSystem &sys, const Exchange &ex, const Vector &x, Vector &y,
-                 Vector &work)
+void g_sigma_apply(const ContactSystem &sys, const Vector &w, const Vector &x, Vector &out)
 {
-  gt_apply(sys, x, work);
-  ex.reverse_sum(work);
-  work.array() *= sys.inv_mass().array();
-  ex.forward(work);
-  y.resize(sys.contact_dofs());
-  dispatch<GRun>(sys, static_cast<const double *>(work.data()), x.data(), y.data());
+  out.resize(sys.contact_dofs());
+  dispatch<GRun>(sys, w.data(), x.data(), out.data());
 }
 
-void body_apply(const ContactSystem &sys, const Exchange &ex, const Vector &x, Vector &y,
-                Vector &work)
+void gt_sigma_inv_g_apply(const ContactSystem &sys, const Vector &w, Vector &out)
 {
-  work = x;
-  ex.forward(work);
-  y.setZero(sys.body_dofs());
-  dispatch<GtgRun>(sys, static_cast<const double *>(work.data()), y.data());
-  ex.reverse_sum(y);
-  const Eigen::Index owned = Eigen::Index(kBodyDofs) * sys.num_owned_bodies();
-  y.head(owned).array() += x.head(owned).array() * sys.mass().head(owned).array();
-  y.tail(y.size() - owned).setZero();
+  out.setZero(sys.body_dofs());
+  dispatch<GtgRun>(sys, w.data(), out.data());
 }
 
 Mat6 jacobian_block(const ContactSystem &sys, int c, int side)
@@ -339,11 +327,6 @@ Mat6 body_coupling_block(const ContactSystem &sys, int c)
   if (sys.contacts()[c].is_wall()) return Mat6::Zero();
   return jacobian_block(sys, c, 0).transpose() * inv_sigma_rows(sys, c).asDiagonal() *
       jacobian_block(sys, c, 1);
-}
-
-Vector mass_diagonal(const ContactSystem &sys)
-{
-  return sys.mass();
 }
 
 }  // namespace fibre

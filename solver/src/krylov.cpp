@@ -6,48 +6,6 @@
 
 namespace fibre {
 
-const char *to_string(StopReason r)
-{
-  switch (r) {
-    case StopReason::converged: return "converged";
-    case StopReason::max_iterations: return "max_iterations";
-    case StopReason::breakdown: return "breakdown";
-    case StopReason::non_finite: return "non_finite";
-    case StopReason::stagnation: return "stagnation";
-  }
-  return "unknown";
-}
-
-bool parse_stop_reason(const std::string &s, StopReason &r)
-{
-  for (StopReason c : {StopReason::converged, StopReason::max_iterations, StopReason::breakdown,
-                       StopReason::non_finite, StopReason::stagnation})
-    if (s == to_string(c)) {
-      r = c;
-      return true;
-    }
-  return false;
-}
-
-const char *to_string(Method m)
-{
-  switch (m) {
-    case Method::uzawa: return "uzawa";
-    case Method::cr: return "cr";
-    case Method::minres: return "minres";
-  }
-  return "unknown";
-}
-
-bool parse_method(const std::string &s, Method &m)
-{
-  if (s == "uzawa" || s == "cg") m = Method::uzawa;
-  else if (s == "cr") m = Method::cr;
-  else if (s == "minres") m = Method::minres;
-  else return false;
-  return true;
-}
-
 namespace {
 
 // What the loop does after an iteration's bookkeeping.
@@ -214,7 +172,7 @@ class Session {
 
 // Preconditioned CG on the Schur complement (thesis Algorithm 3, Uzawa with conjugate
 // directions). rPr = r^T z with z = P^-1 r.
-SolveResult uzawa(const LinearOperator &A, const Preconditioner &P, const Vector &b, Vector &x,
+SolveResult cg(const LinearOperator &A, const Preconditioner &P, const Vector &b, Vector &x,
                   const StopControl &stop, const KrylovMonitor *monitor)
 {
   Session s(A, P, b, x, stop, monitor);
@@ -384,11 +342,14 @@ SolveResult krylov_solve(Method m, const LinearOperator &A, const Preconditioner
                          const KrylovMonitor *monitor)
 {
   switch (m) {
-    case Method::uzawa: return uzawa(A, P, b, x, stop, monitor);
+    case Method::cg: return cg(A, P, b, x, stop, monitor);
     case Method::cr: return conjugate_residual(A, P, b, x, stop, monitor);
     case Method::minres: return minres(A, P, b, x, stop, monitor);
+    case Method::direct:
+    case Method::pgs: break;
   }
-  throw std::invalid_argument("krylov_solve: unknown method");
+  throw std::invalid_argument(std::string("krylov_solve: ") + to_string(m) +
+                              " is not a Krylov method");
 }
 
 }  // namespace fibre

@@ -1,21 +1,10 @@
 #include "fibre/operators.hpp"
 
+#include "fibre/spook.hpp"
+
 #include <cmath>
 
 namespace fibre {
-
-const char *to_string(Form f)
-{
-  return f == Form::contact ? "contact" : "body";
-}
-
-bool parse_form(const std::string &s, Form &f)
-{
-  if (s == "contact") f = Form::contact;
-  else if (s == "body") f = Form::body;
-  else return false;
-  return true;
-}
 
 double LinearOperator::norm(const Vector &x) const
 {
@@ -41,6 +30,28 @@ double BodySpaceOperator::dot(const Vector &x, const Vector &y) const
 {
   const Eigen::Index owned = Eigen::Index(kBodyDofs) * sys_.num_owned_bodies();
   return ex_.sum(x.head(owned).dot(y.head(owned)));
+}
+
+void schur_apply(const ContactSystem &sys, const Exchange &ex, const Vector &x, Vector &y,
+                 Vector &work)
+{
+  gt_apply(sys, x, work);
+  ex.reverse_sum(work);
+  work.array() *= sys.inv_mass().array();
+  ex.forward(work);
+  g_sigma_apply(sys, work, x, y);
+}
+
+void body_apply(const ContactSystem &sys, const Exchange &ex, const Vector &x, Vector &y,
+                Vector &work)
+{
+  work = x;
+  ex.forward(work);
+  gt_sigma_inv_g_apply(sys, work, y);
+  ex.reverse_sum(y);
+  const Eigen::Index owned = Eigen::Index(kBodyDofs) * sys.num_owned_bodies();
+  y.head(owned).array() += x.head(owned).array() * sys.mass().head(owned).array();
+  y.tail(y.size() - owned).setZero();
 }
 
 namespace {
@@ -73,10 +84,7 @@ Vector lambda_from_body(const ContactSystem &sys, const Exchange &ex, const Vect
 
 Vector body_from_lambda(const ContactSystem &sys, const Exchange &ex, const Vector &lambda)
 {
-  Vector y;
-  gt_apply(sys, lambda, y);
-  ex.reverse_sum(y);
-  y.array() *= sys.inv_mass().array();
+  Vector y = velocity_change(sys, ex, lambda);
   zero_ghosts(sys, y);
   return y;
 }

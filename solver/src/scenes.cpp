@@ -1,5 +1,7 @@
 #include "fibre/scenes.hpp"
 
+#include "fibre/spook.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <fstream>

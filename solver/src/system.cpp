@@ -4,8 +4,6 @@
 #include <stdexcept>
 #include <string>
 
-#include "fibre/exchange.hpp"
-#include "fibre/kernels.hpp"
 
 namespace fibre {
 
@@ -118,109 +116,6 @@ void ContactSystem::set_row_mask(const std::vector<unsigned char> &active)
   compute_derived();
   for (Eigen::Index row = 0; row < contact_dofs(); ++row)
     if (!row_active(row)) rhs_[row] = 0.0;
-}
-
-void ContactSystem::permute(const std::vector<int> &new_body, const std::vector<int> &new_contact)
-{
-  const int nb = num_bodies(), nc = num_contacts();
-  if (static_cast<int>(new_body.size()) != nb || static_cast<int>(new_contact.size()) != nc)
-    throw std::invalid_argument("permutation sizes differ from the system");
-  std::vector<Body> bodies(nb);
-  std::vector<char> seen(nb, 0);
-  for (int i = 0; i < nb; ++i) {
-    const int j = new_body[i];
-    if (j < 0 || j >= nb || seen[j]) throw std::invalid_argument("body map is not a permutation");
-    if ((i < num_owned_) != (j < num_owned_))
-      throw std::invalid_argument("body permutation mixes owned and ghost bodies");
-    seen[j] = 1;
-    bodies[j] = bodies_[i];
-  }
-  std::vector<Contact> contacts(nc);
-  std::vector<unsigned char> mask(mask_.empty() ? 0 : mask_.size());
-  Vector rhs(contact_dofs());
-  std::vector<char> cseen(nc, 0);
-  for (int c = 0; c < nc; ++c) {
-    const int d = new_contact[c];
-    if (d < 0 || d >= nc || cseen[d])
-      throw std::invalid_argument("contact map is not a permutation");
-    cseen[d] = 1;
-    Contact k = contacts_[c];
-    k.a = new_body[k.a];
-    if (!k.is_wall()) k.b = new_body[k.b];
-    contacts[d] = k;
-    rhs.segment(Eigen::Index(rows_) * d, rows_) = rhs_.segment(Eigen::Index(rows_) * c, rows_);
-    for (int r = 0; r < rows_ && !mask.empty(); ++r)
-      mask[std::size_t(rows_) * d + r] = mask_[std::size_t(rows_) * c + r];
-  }
-  bodies_ = std::move(bodies);
-  contacts_ = std::move(contacts);
-  mask_ = std::move(mask);
-  rhs_ = std::move(rhs);
-  compute_derived();
-}
-
-Vector body_velocities(const ContactSystem &sys)
-{
-  Vector v(sys.body_dofs());
-  for (int i = 0; i < sys.num_bodies(); ++i) {
-    v.segment<3>(6 * i) = sys.bodies()[i].v;
-    v.segment<3>(6 * i + 3) = sys.bodies()[i].omega;
-  }
-  return v;
-}
-
-Vector external_velocity_change(const ContactSystem &sys)
-{
-  Vector dv(sys.body_dofs());
-  const double h = sys.params().h;
-  for (int i = 0; i < sys.num_bodies(); ++i) {
-    dv.segment<3>(6 * i) = h * sys.bodies()[i].force;
-    dv.segment<3>(6 * i + 3) = h * sys.bodies()[i].torque;
-  }
-  return dv.cwiseProduct(sys.inv_mass());
-}
-
-Vector spook_rhs(const ContactSystem &sys, const Vector *extra_dv)
-{
-  const SpookParams &p = sys.params();
-  const double ups = p.upsilon();
-  Vector w = (1.0 - ups) * body_velocities(sys) + external_velocity_change(sys);
-  if (extra_dv) w += *extra_dv;
-  Vector b;
-  g_apply(sys, w, b);
-  b = -b;
-  for (int c = 0; c < sys.num_contacts(); ++c) {
-    const Eigen::Index row = Eigen::Index(sys.rows()) * c;  // normal row
-    if (sys.row_active(row)) b[row] -= 4.0 / p.h * ups * sys.contacts()[c].gap;
-  }
-  return b;
-}
-
-Vector impulse_velocity_change(const ContactSystem &sys, const Vector &lambda)
-{
-  Vector dv;
-  gt_apply(sys, lambda, dv);
-  return dv.cwiseProduct(sys.inv_mass());
-}
-
-std::vector<long> global_body_index(const Exchange &ex, int num_owned, int num_bodies,
-                                    long &total)
-{
-  const long offset = ex.exclusive_prefix_sum(num_owned);
-  total = static_cast<long>(ex.sum(static_cast<double>(num_owned)));
-  // Carry the ids through a per-body vector (doubles hold integers below 2^53 exactly).
-  Vector ids = Vector::Zero(Eigen::Index(kBodyDofs) * num_bodies);
-  for (int i = 0; i < num_owned; ++i) ids[6 * i] = static_cast<double>(offset + i);
-  ex.forward(ids);
-  std::vector<long> index(num_bodies);
-  for (int i = 0; i < num_bodies; ++i) index[i] = static_cast<long>(ids[6 * i]);
-  return index;
-}
-
-const Exchange &serial_exchange()
-{
-  static const SerialExchange ex;
-  return ex;
 }
 
 }  // namespace fibre

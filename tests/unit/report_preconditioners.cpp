@@ -14,7 +14,7 @@
 #include <string>
 
 #include "fibre/krylov.hpp"
-#include "fibre/preconditioners.hpp"
+#include "fibre/preconditioner_family.hpp"
 #include "fibre/scenes.hpp"
 
 using namespace fibre;
@@ -43,7 +43,7 @@ Vector normal_impulses(const ContactSystem &sys)
   StopControl stop;
   stop.tol = 1e-10;
   stop.max_iter = 2000;
-  krylov_solve(Method::uzawa, K, *P, rhs, dv, stop);
+  krylov_solve(Method::cg, K, *P, rhs, dv, stop);
   const Vector lambda = lambda_from_body(sys, ex, sys.rhs(), dv);
   Vector ln(sys.num_contacts());
   for (int c = 0; c < sys.num_contacts(); ++c) ln[c] = lambda[Eigen::Index(sys.rows()) * c];

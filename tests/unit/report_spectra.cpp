@@ -11,7 +11,7 @@
 #include <cmath>
 #include <cstdio>
 
-#include "fibre/preconditioners.hpp"
+#include "fibre/preconditioner_family.hpp"
 #include "fibre/scenes.hpp"
 #include "fibre/spectra.hpp"
 

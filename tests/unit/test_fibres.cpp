@@ -120,11 +120,11 @@ TEST(Fibres, WeightNames)
 {
   for (EdgeWeight w : kWeights) {
     EdgeWeight back = EdgeWeight::z;
-    ASSERT_TRUE(parse_weight(to_string(w), back));
+    ASSERT_TRUE(parse(to_string(w), back));
     EXPECT_EQ(back, w);
   }
   EdgeWeight w;
-  EXPECT_FALSE(parse_weight("diagonal", w));
+  EXPECT_FALSE(parse("diagonal", w));
 }
 
 // Grid bodies 3 i + k sit at x = 2 i, z = 2 k. The walks below were traced by hand.

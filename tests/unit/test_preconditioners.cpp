@@ -5,7 +5,7 @@
 
 #include <set>
 
-#include "fibre/preconditioners.hpp"
+#include "fibre/preconditioner_family.hpp"
 #include "fibre/scenes.hpp"
 #include "reference.hpp"
 
@@ -182,11 +182,11 @@ TEST(Preconditioners, Names)
 {
   for (PrecondKind k : kKinds) {
     PrecondKind back = PrecondKind::none;
-    ASSERT_TRUE(parse_precond(to_string(k), back));
+    ASSERT_TRUE(parse(to_string(k), back));
     EXPECT_EQ(back, k);
   }
   PrecondKind k;
-  EXPECT_FALSE(parse_precond("ilu", k));
+  EXPECT_FALSE(parse("ilu", k));
 }
 
 TEST(Preconditioners, Grid)

@@ -8,7 +8,7 @@
 #include <random>
 
 #include "fibre/kernels.hpp"
-#include "fibre/preconditioners.hpp"
+#include "fibre/preconditioner_family.hpp"
 #include "fibre/scenes.hpp"
 #include "fibre/spectra.hpp"
 #include "reference.hpp"

@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "fibre/names.hpp"
 #include "fibre/system.hpp"
 
 namespace fibre {
@@ -17,8 +18,11 @@ enum class EdgeWeight {
   straight,  // misalignment with the previous edge of the chain (prefers straight chains)
   impulse,   // minus the last normal impulse (follows force chains)
 };
-const char *to_string(EdgeWeight w);
-bool parse_weight(const std::string &s, EdgeWeight &w);
+template <>
+struct EnumNames<EdgeWeight> {
+  static constexpr EnumName<EdgeWeight> table[] = {
+      {EdgeWeight::z, "z"}, {EdgeWeight::straight, "straight"}, {EdgeWeight::impulse, "impulse"}};
+};
 
 struct FibreStats {
   int num_fibres = 0;
@@ -81,23 +85,6 @@ Fibres build_fibres(const ContactSystem &sys, EdgeWeight weight, const Vector *i
 double edge_weight(const ContactSystem &sys, EdgeWeight weight, const Vector *impulses, int c,
                    int from, const Vec3 &prev_dir);
 
-// New numbering, as ContactSystem::permute takes it: new_body[i] is the new index of body i,
-// new_contact[c] of contact c. Fibre contacts come first, fibre by fibre in chain order, then
-// the others in their old order; bodies likewise, owned and ghost bodies each in their own
-// range so that ownership is preserved.
-struct Relabelling {
-  std::vector<int> new_body;
-  std::vector<int> new_contact;
-};
-Relabelling relabel_for_fibres(const ContactSystem &sys, const Fibres &fibres);
-// Renumbers `fibres` into the new labels.
-Fibres relabelled(const Fibres &fibres, const Relabelling &r);
-// Builds nothing: permutes `sys` by relabel_for_fibres and renumbers `fibres` in place, so
-// that afterwards fibre f's contacts are contact_start[f] .. contact_start[f+1]-1.
-Relabelling relabel_system(ContactSystem &sys, Fibres &fibres);
-// A contact-space vector (rows entries per contact) in the new numbering; rows = 1 for
-// per-contact numbers such as the impulses of EdgeWeight::impulse.
-Vector relabel_contact_vector(const Relabelling &r, int rows, const Vector &x);
 
 // Rooted spanning forest of the body graph: the fibres (built with the same weight), then the
 // remaining body-body contacts joining two different trees in increasing order of a static

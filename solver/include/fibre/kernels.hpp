@@ -1,11 +1,10 @@
 // Matrix-free kernels on a ContactSystem (thesis 2.5.2): G is never formed.
 //
 // Contact-space vectors have rows() entries per contact; body-space vectors have 6 entries
-// per body (owned bodies first, then ghosts). Local kernels touch only this process's data;
-// the operators in operators.hpp add the halo exchange.
+// per body (owned bodies first, then ghosts). Every kernel here is local: it touches only
+// this process's data; the operators in operators.hpp add the halo exchange.
 #pragma once
 
-#include "fibre/exchange.hpp"
 #include "fibre/system.hpp"
 
 namespace fibre {
@@ -15,12 +14,10 @@ void g_apply(const ContactSystem &sys, const Vector &w, Vector &out);
 // out = G^T lambda, accumulated per body (local: ghosts hold partial sums).
 void gt_apply(const ContactSystem &sys, const Vector &lambda, Vector &out);
 
-// y = (G M^-1 G^T + Sigma) x. `work` is a body-space scratch vector.
-void schur_apply(const ContactSystem &sys, const Exchange &ex, const Vector &x, Vector &y,
-                 Vector &work);
-// y = (M + G^T Sigma^-1 G) x for a body-space x; ghost entries of y are zero.
-void body_apply(const ContactSystem &sys, const Exchange &ex, const Vector &x, Vector &y,
-                Vector &work);
+// Fused local products for the operators: out = G w + Sigma x, and out = G^T Sigma^-1 G w
+// accumulated per body (w complete on ghosts; ghosts of out hold partial sums).
+void g_sigma_apply(const ContactSystem &sys, const Vector &w, const Vector &x, Vector &out);
+void gt_sigma_inv_g_apply(const ContactSystem &sys, const Vector &w, Vector &out);
 
 // The Jacobian block of contact c for its body a (side 0) or b (side 1): rows() x 6, padded
 // with zero rows to 6x6. Masked rows are zero.
@@ -39,8 +36,5 @@ Mat6 coupling_block(const ContactSystem &sys, int c, int d);
 std::vector<Mat6> body_diagonal_blocks(const ContactSystem &sys);
 // Off-diagonal block K_ab = G_ca^T Sigma_c^-1 G_cb of a body-body contact c.
 Mat6 body_coupling_block(const ContactSystem &sys, int c);
-
-// Dense M (6 per body) as a vector: the diagonal of M.
-Vector mass_diagonal(const ContactSystem &sys);
 
 }  // namespace fibre

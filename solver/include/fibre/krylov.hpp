@@ -1,6 +1,6 @@
-// Preconditioned Krylov methods on a LinearOperator: Uzawa (CG on the Schur complement,
-// thesis Algorithm 3), Conjugate Residual and MINRES. One loop skeleton each, typed stop
-// reasons (PETSc KSP style) and stopping rules kept apart from the method (deal.II style).
+// Preconditioned Krylov methods on a LinearOperator: CG (in the contact form the thesis's
+// Uzawa, Algorithm 3), Conjugate Residual and MINRES. One loop skeleton each; the stop reasons
+// and the stopping rule are in solver_control.hpp.
 #pragma once
 
 #include <functional>
@@ -9,35 +9,9 @@
 
 #include "fibre/operators.hpp"
 #include "fibre/preconditioner.hpp"
+#include "fibre/solver_control.hpp"
 
 namespace fibre {
-
-// converged: ||b - A x|| / ||b|| <= tol, checked on the TRUE residual (or StopControl::accept).
-// max_iterations: stop.max_iter iterations without convergence.
-// breakdown: a zero or negative curvature / denominator (A or P not SPD, Lanczos exhausted).
-// non_finite: NaN/Inf met; x is the last finite iterate (the initial guess, or 0 when that
-//   was not finite either).
-// stagnation: the recursively updated residual (or MINRES's estimate) met tol but the true one
-//   did not, kMaxResidualChecks times in a row without the true residual halving in between
-//   (the attainable accuracy in floating point is above tol).
-enum class StopReason { converged, max_iterations, breakdown, non_finite, stagnation };
-const char *to_string(StopReason r);
-bool parse_stop_reason(const std::string &s, StopReason &r);
-inline constexpr int kMaxResidualChecks = 3;
-
-enum class Method { uzawa, cr, minres };
-const char *to_string(Method m);
-bool parse_method(const std::string &s, Method &m);  // "uzawa" (alias "cg"), "cr", "minres"
-
-// Stop when ||r|| / ||b|| <= tol (operator's inner product), or after max_iter iterations.
-struct StopControl {
-  double tol = 1e-6;
-  int max_iter = 500;
-  // Optional extra rule (deal.II SolverControl style), e.g. a velocity-change test (design.md
-  // section 4): called after every iteration k >= 1 with the iterate; true stops the method
-  // with StopReason::converged whatever the residual. It must decide alike on every process.
-  std::function<bool(int k, const Vector &x)> accept;
-};
 
 // Entry 0 is the initial guess. r is the recursively updated residual b - A x of every method
 // (CG and CR carry it; MINRES carries it through A w_k alongside the Lanczos recurrence, at
@@ -74,10 +48,11 @@ struct SolveResult {
 // MINRES also checks when its estimate ||r||_P / ||b||_P meets tol while its updated residual
 // has levelled off (no new minimum for 10 iterations): at the attainable accuracy the updated
 // residual stops falling while the estimate goes on.
-// uzawa: preconditioned CG on the Schur complement (thesis Algorithm 3).
+// cg: preconditioned CG; in the contact form CG on the Schur complement (thesis Algorithm 3,
+// Uzawa).
 // conjugate_residual: preconditioned CR, minimises ||r||_P over the Krylov space.
 // minres: Paige-Saunders MINRES with an SPD preconditioner, minimises ||r||_P as well.
-SolveResult uzawa(const LinearOperator &A, const Preconditioner &P, const Vector &b, Vector &x,
+SolveResult cg(const LinearOperator &A, const Preconditioner &P, const Vector &b, Vector &x,
                   const StopControl &stop, const KrylovMonitor *monitor = nullptr);
 SolveResult conjugate_residual(const LinearOperator &A, const Preconditioner &P, const Vector &b,
                                Vector &x, const StopControl &stop,

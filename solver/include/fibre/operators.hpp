@@ -7,12 +7,15 @@
 
 #include "fibre/exchange.hpp"
 #include "fibre/kernels.hpp"
+#include "fibre/names.hpp"
 
 namespace fibre {
 
 enum class Form { contact, body };
-const char *to_string(Form f);
-bool parse_form(const std::string &s, Form &f);
+template <>
+struct EnumNames<Form> {
+  static constexpr EnumName<Form> table[] = {{Form::contact, "contact"}, {Form::body, "body"}};
+};
 
 // Symmetric positive definite operator with its own (global) inner product.
 class LinearOperator {
@@ -53,6 +56,13 @@ class BodySpaceOperator final : public LinearOperator {
   const Exchange &ex_;
   mutable Vector work_;
 };
+
+// y = (G M^-1 G^T + Sigma) x. `work` is a body-space scratch vector.
+void schur_apply(const ContactSystem &sys, const Exchange &ex, const Vector &x, Vector &y,
+                 Vector &work);
+// y = (M + G^T Sigma^-1 G) x for a body-space x; ghost entries of y are zero.
+void body_apply(const ContactSystem &sys, const Exchange &ex, const Vector &x, Vector &y,
+                Vector &work);
 
 // Body-space right-hand side G^T Sigma^-1 b (owned entries complete, ghosts zero).
 Vector body_rhs(const ContactSystem &sys, const Exchange &ex, const Vector &b);

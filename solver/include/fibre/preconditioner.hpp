@@ -5,7 +5,7 @@
 #include <memory>
 #include <string>
 
-#include "fibre/operators.hpp"
+#include "fibre/system.hpp"
 
 namespace fibre {
 

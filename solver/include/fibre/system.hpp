@@ -111,11 +111,6 @@ class ContactSystem {
   void set_row_mask(const std::vector<unsigned char> &active);  // 1 = active row
   bool row_active(Eigen::Index row) const { return mask_.empty() || mask_[row] != 0; }
 
-  // Renumber bodies and contacts (used by the fibre relabelling). new_body[i] is the new
-  // index of body i, new_contact[c] the new index of contact c. Owned bodies must stay in
-  // [0, num_owned). Everything derived is permuted along.
-  void permute(const std::vector<int> &new_body, const std::vector<int> &new_contact);
-
  private:
   void compute_derived();
 
@@ -134,21 +129,5 @@ class ContactSystem {
   std::vector<int> pairs_;  // a, b per contact
   Vector rhs_;
 };
-
-// ---- SPOOK step (design.md section 2) ----
-
-// Per-body velocity vector (v, omega) stacked, 6 per body.
-Vector body_velocities(const ContactSystem &sys);
-// h M^-1 f_ext per body (the free-flight velocity change).
-Vector external_velocity_change(const ContactSystem &sys);
-
-// b = -(4/h) Upsilon g - (1 - Upsilon) G v - G (h M^-1 f_ext + extra_dv).
-// extra_dv (optional, 6 per body) is a velocity change from impulses held fixed outside the
-// solve (capped friction rows); it must be complete on ghosts as well.
-Vector spook_rhs(const ContactSystem &sys, const Vector *extra_dv = nullptr);
-
-// Sum of the contact impulses on every body, dv = M^-1 G^T lambda (local part: the caller
-// reverse-sums ghosts for MPI).
-Vector impulse_velocity_change(const ContactSystem &sys, const Vector &lambda);
 
 }  // namespace fibre

@@ -1,38 +1,32 @@
-#include "fibre/contact_solver.hpp"
+#include "fibre/step_solver.hpp"
 
-#include <array>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <limits>
-#include <stdexcept>
 
+#include "fibre/cones.hpp"
 #include "fibre/direct.hpp"
 #include "fibre/kernels.hpp"
+#include "fibre/pgs.hpp"
+#include "fibre/spook.hpp"
 
 namespace fibre {
 
-const char *to_string(SolverKind s)
+std::string describe(const StepOptions &opt)
 {
-  switch (s) {
-    case SolverKind::uzawa: return "uzawa";
-    case SolverKind::cr: return "cr";
-    case SolverKind::minres: return "minres";
-    case SolverKind::direct: return "direct";
-  }
-  return "unknown";
-}
-
-bool parse_solver(const std::string &s, SolverKind &k)
-{
-  if (s == "direct" || s == "mumps") {
-    k = SolverKind::direct;
-    return true;
-  }
-  Method m;
-  if (!parse_method(s, m)) return false;
-  k = m == Method::uzawa ? SolverKind::uzawa : m == Method::cr ? SolverKind::cr
-                                                                 : SolverKind::minres;
-  return true;
+  auto g = [](double x) {
+    char buf[32];
+    std::snprintf(buf, sizeof(buf), "%.6g", x);
+    return std::string(buf);
+  };
+  return std::string("form ") + to_string(opt.form) + ", solver " + to_string(opt.solver) +
+         ", precond " + to_string(opt.precond.kind) + ", weight " +
+         to_string(opt.precond.weight) + ", tol " + g(opt.stop.tol) + ", pass_tol " +
+         g(opt.pass_tol) + ", maxiter " + std::to_string(opt.stop.max_iter) + ", mu " +
+         g(opt.friction.mu) + ", mu_roll " + g(opt.friction.mu_roll) + ", mu_twist " +
+         g(opt.friction.mu_twist) + ", active_set " + std::to_string(opt.active_set_max) +
+         ", sweeps " + std::to_string(opt.sweeps) + ", sweep_tol " + g(opt.sweep_tol);
 }
 
 namespace {
@@ -42,36 +36,6 @@ using Clock = std::chrono::steady_clock;
 double seconds_since(Clock::time_point t0)
 {
   return std::chrono::duration<double>(Clock::now() - t0).count();
-}
-
-Method krylov_method(SolverKind s)
-{
-  if (s == SolverKind::uzawa) return Method::uzawa;
-  return s == SolverKind::cr ? Method::cr : Method::minres;
-}
-
-// The cones of one contact: Coulomb (rows 1, 2), twisting (row 3), rolling (rows 4, 5).
-struct Cone {
-  int first, size;
-};
-constexpr Cone kCones[3] = {{1, 2}, {3, 1}, {4, 2}};
-
-int num_cones(int rows) { return rows == 6 ? 3 : 1; }
-
-double effective_radius(const ContactSystem &sys, int c)
-{
-  const Contact &k = sys.contacts()[c];
-  const double ra = sys.bodies()[k.a].radius;
-  if (k.is_wall()) return ra;
-  const double rb = sys.bodies()[k.b].radius;
-  return ra * rb / (ra + rb);
-}
-
-// Cone radius per unit normal impulse.
-double cone_coefficient(const ContactSystem &sys, const FrictionParams &f, int c, int cone)
-{
-  if (cone == 0) return f.mu;
-  return (cone == 1 ? f.mu_twist : f.mu_roll) * effective_radius(sys, c);
 }
 
 // One contact's place in the active set. A capped cone holds its impulse on the boundary,
@@ -87,56 +51,39 @@ struct ContactState {
                            Eigen::Vector2d::Zero()};
 };
 
-Eigen::Vector2d cone_values(const Vector &v, Eigen::Index base, const Cone &cone)
-{
-  Eigen::Vector2d t(v[base + cone.first], 0.0);
-  if (cone.size == 2) t[1] = v[base + cone.first + 1];
-  return t;
-}
-
-void set_cone(Vector &v, Eigen::Index base, const Cone &cone, const Eigen::Vector2d &t)
-{
-  v[base + cone.first] = t[0];
-  if (cone.size == 2) v[base + cone.first + 1] = t[1];
-}
-
-// The active-set loop of design.md section 2 around one linear solver.
+// The active-set loop of doc/design.md section 2 around one linear solver, then the sweeps.
 class StepSolver {
  public:
   StepSolver(ContactSystem &sys, const Exchange &ex, const StepOptions &opt, MPI_Comm comm)
       : sys_(sys), ex_(ex), opt_(opt), comm_(comm), rows_(sys.rows()),
-        nc_(sys.num_contacts()), coeff_(std::size_t(nc_) * 3, 0.0), state_(nc_),
+        nc_(sys.num_contacts()), cones_(sys, opt.friction), state_(nc_),
         all_rows_(sys.contact_dofs(), 1)
   {
-    for (int c = 0; c < nc_; ++c)
-      for (int k = 0; k < num_cones(rows_); ++k)
-        coeff_[3 * std::size_t(c) + k] = cone_coefficient(sys, opt.friction, c, k);
   }
 
   StepResult run(const Vector *warm);
 
  private:
-  double coeff(int c, int k) const { return coeff_[3 * std::size_t(c) + k]; }
+  Vector initial_impulses(const Vector *warm);
+  void active_set_loop(Vector &lambda, StepResult &res);
+
+  double coeff(int c, int k) const { return cones_.coeff(c, k); }
   Eigen::Index base(int c) const { return Eigen::Index(rows_) * c; }
   std::vector<unsigned char> active_mask() const;
   Vector fixed_impulses(const Vector &lambda) const;
-  Vector velocity_change(const Vector &lambda) const;
   Vector linear_solve(const Vector &b, const Vector &warm, const StopControl &stop, bool tight,
                       StepResult &res);
   int update_set(const Vector &lambda, const std::vector<unsigned char> &mask);
   void project(Vector &lambda) const;
-  std::vector<Vec6> row_scales() const;
-  void project_contact(double *l, int c) const;
-  void sweep(Vector &lambda, const std::vector<Vec6> &scale, StepResult &res) const;
+  void finish(Vector &lambda, StepResult &res) const;
   void count_set(const Vector &lambda, StepResult &res) const;
-  double complementarity(const Vector &lambda, const std::vector<Vec6> &scale) const;
 
   ContactSystem &sys_;
   const Exchange &ex_;
   const StepOptions &opt_;
   MPI_Comm comm_;
   const int rows_, nc_;
-  std::vector<double> coeff_;  // cone coefficient per contact and cone
+  const Cones cones_;
   std::vector<ContactState> state_;
   const std::vector<unsigned char> all_rows_;
   Vector b_full_;  // the rhs with every row active and no fixed impulses
@@ -171,17 +118,6 @@ Vector StepSolver::fixed_impulses(const Vector &lambda) const
   return fixed;
 }
 
-// M^-1 G^T lambda, complete on owned bodies and ghosts (the rows of the current mask).
-Vector StepSolver::velocity_change(const Vector &lambda) const
-{
-  Vector dv;
-  gt_apply(sys_, lambda, dv);
-  ex_.reverse_sum(dv);
-  dv.array() *= sys_.inv_mass().array();
-  ex_.forward(dv);
-  return dv;
-}
-
 // Solves the masked system A lambda = b in the chosen form and returns lambda.
 // A loose solve (tight false) that misses its tol does not count as a failed solve: the
 // passes after it go on from its iterate.
@@ -195,7 +131,7 @@ Vector StepSolver::linear_solve(const Vector &b, const Vector &warm, const StopC
     sr.reason = StopReason::non_finite;
     sr.rel_residual = std::numeric_limits<double>::infinity();
     lambda = warm;
-  } else if (opt_.solver == SolverKind::direct) {
+  } else if (opt_.solver == Method::direct) {
     const auto t0 = Clock::now();
     lambda = direct_solve(opt_.form, sys_, ex_, b, comm_);
     res.solve_seconds += seconds_since(t0);
@@ -224,7 +160,7 @@ Vector StepSolver::linear_solve(const Vector &b, const Vector &warm, const StopC
     res.setup_seconds += seconds_since(t0);
     const auto t1 = Clock::now();
     const auto A = make_operator(opt_.form, sys_, ex_);
-    const Method m = krylov_method(opt_.solver);
+    const Method m = opt_.solver;
     if (opt_.form == Form::contact) {
       lambda = warm;
       sr = krylov_solve(m, *A, *P, b, lambda, stop);
@@ -256,7 +192,7 @@ Vector StepSolver::linear_solve(const Vector &b, const Vector &warm, const StopC
 int StepSolver::update_set(const Vector &lambda, const std::vector<unsigned char> &mask)
 {
   Vector G_dv;
-  g_apply(sys_, velocity_change(lambda), G_dv);
+  g_apply(sys_, velocity_change(sys_, ex_, lambda), G_dv);
   const Vector rho = b_full_ - G_dv - sys_.sigma().cwiseProduct(lambda);
   // One Gauss-Seidel step per row outside the solve: lambda + rho / A_ii. Dividing by Sigma
   // alone (tiny) would only see the sign of rho and never find a cone's interior.
@@ -336,95 +272,22 @@ void StepSolver::project(Vector &lambda) const
   }
 }
 
-// Per-row scaling of the projected maps below: A_ii for the normal row and the largest A_ii
-// of each cone for all its rows. One scale per cone keeps the direction of the cone's step, so
-// a fixed point has its friction along the slip (maximal dissipation). A full 6x6 block solve
-// would not: it mixes the slip into the normal row, and projected sweeps with it converge to
-// impulses whose friction is off the slip (complementarity residual 9% in the material scene).
-std::vector<Vec6> StepSolver::row_scales() const
+// Projected Gauss-Seidel on the full system while the impulses are not accurate enough:
+// they finish what the active-set loop leaves (an unsettled set, caps from a lagged l_n, a
+// loose last pass), or do the whole solve (Method::pgs).
+void StepSolver::finish(Vector &lambda, StepResult &res) const
 {
-  std::vector<Vec6> scale(nc_, Vec6::Ones());
-  for (int c = 0; c < nc_; ++c) {
-    const Mat6 D = diagonal_block(sys_, c);
-    scale[c][0] = D(0, 0);
-    for (int k = 0; k < num_cones(rows_); ++k) {
-      const Cone &cone = kCones[k];
-      double d = D(cone.first, cone.first);
-      if (cone.size == 2) d = std::max(d, D(cone.first + 1, cone.first + 1));
-      for (int i = 0; i < cone.size; ++i) scale[c][cone.first + i] = d;
-    }
+  const auto t_sweep = Clock::now();
+  const std::vector<Vec6> scale = row_scales(sys_);
+  res.complementarity = complementarity(sys_, ex_, cones_, b_full_, lambda, scale);
+  if (opt_.sweeps > 0 && res.complementarity > opt_.sweep_tol) {
+    const PgsResult pr =
+        pgs(sys_, ex_, cones_, b_full_, scale, lambda, PgsControl{opt_.sweeps, opt_.sweep_tol});
+    res.sweeps = pr.sweeps;
+    res.sweep_reason = pr.reason;
+    res.complementarity = complementarity(sys_, ex_, cones_, b_full_, lambda, scale);
   }
-  return scale;
-}
-
-// lambda_n >= 0 and every cone (radius from the projected normal impulse); l points to the
-// contact's rows. Hot in the sweeps: squared norms, one square root only for a cone outside.
-void StepSolver::project_contact(double *l, int c) const
-{
-  l[0] = l[0] > 0 ? l[0] : 0.0;  // also NaN -> 0
-  if (!std::isfinite(l[0])) l[0] = 0.0;
-  for (int k = 0; k < num_cones(rows_); ++k) {
-    double *t = l + kCones[k].first;
-    const bool pair = kCones[k].size == 2;
-    const double radius = coeff(c, k) * l[0];
-    const double tn2 = t[0] * t[0] + (pair ? t[1] * t[1] : 0.0);
-    if (!(radius > 0) || !std::isfinite(tn2)) {
-      t[0] = 0.0;
-      if (pair) t[1] = 0.0;
-    } else if (tn2 > radius * radius) {
-      const double shrink = radius / std::sqrt(tn2);
-      t[0] *= shrink;
-      if (pair) t[1] *= shrink;
-    }
-  }
-}
-
-// Projected Gauss-Seidel sweeps (nonlinear Gauss-Seidel) on the full system, from feasible
-// impulses: each contact in turn moves to lambda_c + rho_c / scale_c with its current residual
-// and is projected; the body velocities follow every update. They finish what the active-set
-// loop leaves: an unsettled set, caps from a lagged l_n, a loose last pass. Stops when a
-// sweep moves lambda by at most sweep_tol relative to |lambda| (2-norms over all processes).
-// In parallel each process sweeps its own contacts; bodies shared with another process see
-// the other's updates at the next sweep (block Jacobi across processes).
-void StepSolver::sweep(Vector &lambda, const std::vector<Vec6> &scale, StepResult &res) const
-{
-  std::vector<std::array<Mat6, 2>> J(nc_);
-  for (int c = 0; c < nc_; ++c) J[c] = {jacobian_block(sys_, c, 0), jacobian_block(sys_, c, 1)};
-  const Vector &inv_mass = sys_.inv_mass();
-  const Vector &sigma = sys_.sigma();
-  Vector dv = velocity_change(lambda);
-  Vector dv_start, moved;  // reused by every sweep
-  for (int s = 0; s < opt_.sweeps; ++s) {
-    // dv follows this process's updates; `moved` collects them for the other processes.
-    dv_start = dv;
-    double norms[2] = {0, 0};  // ||change||^2, ||lambda||^2
-    for (int c = 0; c < nc_; ++c) {
-      const Contact &k = sys_.contacts()[c];
-      const Eigen::Index at = base(c), ia = 6 * Eigen::Index(k.a), ib = 6 * Eigen::Index(k.b);
-      Vec6 G_dv = J[c][0] * dv.segment<6>(ia);
-      if (!k.is_wall()) G_dv += J[c][1] * dv.segment<6>(ib);
-      Vec6 old = Vec6::Zero();
-      old.head(rows_) = lambda.segment(at, rows_);
-      for (int i = 0; i < rows_; ++i)
-        lambda[at + i] += (b_full_[at + i] - G_dv[i] - sigma[at + i] * old[i]) / scale[c][i];
-      project_contact(lambda.data() + at, c);
-      Vec6 change = Vec6::Zero();
-      change.head(rows_) = lambda.segment(at, rows_) - old.head(rows_);
-      dv.segment<6>(ia) += inv_mass.segment<6>(ia).cwiseProduct(J[c][0].transpose() * change);
-      if (!k.is_wall())
-        dv.segment<6>(ib) += inv_mass.segment<6>(ib).cwiseProduct(J[c][1].transpose() * change);
-      norms[0] += change.squaredNorm();
-      norms[1] += lambda.segment(at, rows_).squaredNorm();
-    }
-    // Every process's updates on every body: the sum of the local changes, owners and ghosts.
-    moved = dv - dv_start;
-    ex_.reverse_sum(moved);
-    ex_.forward(moved);
-    dv = dv_start + moved;
-    ex_.sum(norms, 2);
-    ++res.sweeps;
-    if (!(norms[0] > opt_.sweep_tol * opt_.sweep_tol * norms[1])) break;
-  }
+  res.sweep_seconds = seconds_since(t_sweep);
 }
 
 // Released contacts and rows on a cone boundary of feasible impulses.
@@ -448,48 +311,30 @@ void StepSolver::count_set(const Vector &lambda, StepResult &res) const
   res.capped = static_cast<int>(counts[1]);
 }
 
-// How far feasible impulses are from solving the contact problem: the step of the projected
-// Jacobi map, || lambda - P(lambda + rho / scale) ||_2 / ||lambda||_2 over all processes, with
-// rho the residual of the full system, P the projection onto lambda_n >= 0 and the cones, and
-// the scales of row_scales(). It is zero exactly when lambda solves the step: active normal rows
-// solved, released contacts not pressing, sticking cones without slip, sliding cones on their
-// boundary against the slip.
-double StepSolver::complementarity(const Vector &lambda, const std::vector<Vec6> &scale) const
+// The warm start when every process has a usable one (the decision is global: the solves are
+// collective), else zero. Its trial impulses give the first set: contacts that opened since the
+// last step start released and sliding cones start capped against the slip. (Capping the cones
+// whose warm impulse lies on the boundary instead gave 2-6x deeper overlaps in the material
+// scene.)
+Vector StepSolver::initial_impulses(const Vector *warm)
 {
-  Vector G_dv;
-  g_apply(sys_, velocity_change(lambda), G_dv);
-  const Vector rho = b_full_ - G_dv - sys_.sigma().cwiseProduct(lambda);
-  Vector trial = lambda;
-  for (int c = 0; c < nc_; ++c)
-    for (int i = 0; i < rows_; ++i) trial[base(c) + i] += rho[base(c) + i] / scale[c][i];
-  for (int c = 0; c < nc_; ++c) project_contact(trial.data() + base(c), c);
-  double sums[2] = {(trial - lambda).squaredNorm(), lambda.squaredNorm()};
-  ex_.sum(sums, 2);
-  if (!(sums[1] > 0)) return sums[0] > 0 ? 1.0 : 0.0;
-  return std::sqrt(sums[0] / sums[1]);
-}
-
-StepResult StepSolver::run(const Vector *warm)
-{
-  const auto t_start = Clock::now();
-  StepResult res;
   const Eigen::Index n = sys_.contact_dofs();
-  sys_.set_row_mask(all_rows_);
-  b_full_ = spook_rhs(sys_);
-  // An unusable warm start is replaced by zero; the decision is global (collective solves).
   const bool warm_ok = warm && warm->size() == n && warm->allFinite();
   const bool use_warm = ex_.max(warm_ok ? 0.0 : 1.0) == 0.0;
   Vector lambda = use_warm ? *warm : Vector::Zero(n);
-  // The first set comes from the warm start's trial impulses: contacts that opened since the
-  // last step start released and sliding cones start capped against the slip. (Capping the
-  // cones whose warm impulse lies on the boundary instead gave 2-6x deeper overlaps in the
-  // material scene.)
-  if (use_warm) update_set(lambda, std::vector<unsigned char>(n, 0));
+  if (use_warm && opt_.solver != Method::pgs) update_set(lambda, std::vector<unsigned char>(n, 0));
+  return lambda;
+}
 
+// The bounded active-set loop: each pass solves the current set's rows, then the set follows
+// the pass's impulses.
+void StepSolver::active_set_loop(Vector &lambda, StepResult &res)
+{
+  const Eigen::Index n = sys_.contact_dofs();
   // Passes that only decide the set solve to pass_tol; once the set has settled (or at the
   // last pass) one solve to tol follows, warm-started from the loose one.
   const int max_passes = std::max(1, opt_.active_set_max);
-  bool tight = !(opt_.pass_tol > opt_.stop.tol) || opt_.solver == SolverKind::direct;
+  bool tight = !(opt_.pass_tol > opt_.stop.tol) || opt_.solver == Method::direct;
   double last_changes = std::numeric_limits<double>::infinity();
   for (int pass = 0; pass < max_passes; ++pass) {
     if (pass == max_passes - 1) tight = true;
@@ -497,7 +342,7 @@ StepResult StepSolver::run(const Vector *warm)
     if (!tight) stop.tol = opt_.pass_tol;
     // Capped cones enter the rhs as a fixed velocity change, computed with every row active.
     const Vector fixed = fixed_impulses(lambda);
-    const Vector extra_dv = velocity_change(fixed);
+    const Vector extra_dv = velocity_change(sys_, ex_, fixed);
     const std::vector<unsigned char> mask = active_mask();
     sys_.set_row_mask(mask);
     const Vector b = spook_rhs(sys_, &extra_dv);
@@ -530,19 +375,24 @@ StepResult StepSolver::run(const Vector *warm)
     if (global_changes >= last_changes) tight = true;
     last_changes = global_changes;
   }
+}
+
+StepResult StepSolver::run(const Vector *warm)
+{
+  const auto t_start = Clock::now();
+  StepResult res;
+  sys_.set_row_mask(all_rows_);
+  b_full_ = spook_rhs(sys_);
+  Vector lambda = initial_impulses(warm);
+  if (opt_.solver != Method::pgs) active_set_loop(lambda, res);
   // Feasible impulses, then projected Gauss-Seidel sweeps while they are not accurate enough.
   // (Projecting an unsettled pass alone could zero a tensile impulse that balances large
   // compressive ones and kick the bodies between them: 29 m/s in one silo step.)
   project(lambda);
-  if (last_reason_ != StopReason::non_finite) {
-    const auto t_sweep = Clock::now();
-    const std::vector<Vec6> scale = row_scales();
-    res.complementarity = complementarity(lambda, scale);
-    if (opt_.sweeps > 0 && res.complementarity > opt_.sweep_tol) {
-      sweep(lambda, scale, res);
-      res.complementarity = complementarity(lambda, scale);
-    }
-    res.sweep_seconds = seconds_since(t_sweep);
+  if (last_reason_ != StopReason::non_finite) finish(lambda, res);
+  if (opt_.solver == Method::pgs && res.complementarity > opt_.sweep_tol) {
+    res.converged = false;
+    res.reason = res.sweep_reason;
   }
   count_set(lambda, res);
   sys_.set_rhs(b_full_);

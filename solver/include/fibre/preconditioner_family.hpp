@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "fibre/fibres.hpp"
+#include "fibre/operators.hpp"
 #include "fibre/preconditioner.hpp"
 
 namespace fibre {
@@ -29,8 +30,14 @@ namespace fibre {
 // Fibres and forests use this process's contacts; contact-form chains may pass through ghost
 // bodies, body-form ones never do. apply() is not reentrant (it uses a work vector).
 enum class PrecondKind { none, jacobi, block, fibre, tree };
-const char *to_string(PrecondKind k);
-bool parse_precond(const std::string &s, PrecondKind &k);
+template <>
+struct EnumNames<PrecondKind> {
+  static constexpr EnumName<PrecondKind> table[] = {{PrecondKind::none, "none"},
+                                                    {PrecondKind::jacobi, "jacobi"},
+                                                    {PrecondKind::block, "block"},
+                                                    {PrecondKind::fibre, "fibre"},
+                                                    {PrecondKind::tree, "tree"}};
+};
 
 struct PrecondOptions {
   PrecondKind kind = PrecondKind::block;

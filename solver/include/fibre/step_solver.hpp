@@ -1,51 +1,51 @@
-// One SPOOK step's contact solve: preconditioner setup, linear solve in either form, the
-// bounded active-set loop for lambda_n >= 0, Coulomb friction and rolling/twisting
-// resistance (design.md section 2), and projected Gauss-Seidel sweeps that finish it. This is
-// what the LAMMPS fix calls every step.
+// One SPOOK step's contact solve: the orchestration of the sibling solvers. A linear pass
+// (Krylov with a preconditioner in either form, or MUMPS) inside the bounded active-set loop
+// for lambda_n >= 0 and the cones (doc/design.md section 2), then projected Gauss-Seidel
+// (pgs.hpp) to finish; or projected Gauss-Seidel alone (Method::pgs). This is what the front
+// ends call every step.
 #pragma once
 
 #include <mpi.h>
 
 #include <string>
 
+#include "fibre/contact_model.hpp"
 #include "fibre/krylov.hpp"
-#include "fibre/preconditioners.hpp"
+#include "fibre/pgs.hpp"
+#include "fibre/preconditioner_family.hpp"
 
 namespace fibre {
 
-enum class SolverKind { uzawa, cr, minres, direct };
-const char *to_string(SolverKind s);
-bool parse_solver(const std::string &s, SolverKind &k);
-
-// r_eff = ra rb / (ra + rb) for a pair, ra against a wall. A zero coefficient means no
-// resistance: those rows never enter the solve and carry no impulse.
-struct FrictionParams {
-  double mu = 0.5;        // Coulomb: |lambda_t| <= mu lambda_n
-  double mu_roll = 0.0;   // rolling: |lambda_roll| <= mu_roll r_eff lambda_n
-  double mu_twist = 0.0;  // twisting: |lambda_twist| <= mu_twist r_eff lambda_n
-};
-
+// The one home of the step's defaults, measured on the material and silo scenes
+// (doc/design.md section 8, doc/fix_fibre_contact.md "Solvers"). Front ends override only
+// what the user typed.
 struct StepOptions {
   Form form = Form::body;
-  SolverKind solver = SolverKind::minres;
-  PrecondOptions precond{};
-  StopControl stop{};
+  Method solver = Method::cg;
+  PrecondOptions precond{PrecondKind::tree, EdgeWeight::z, nullptr};
+  // The last (tight) linear pass solves to tol: tighter solves bought no accuracy once the
+  // sweeps finish the step, only time.
+  StopControl stop{1e-4, 200, {}};
   FrictionParams friction{};
-  int active_set_max = 5;  // K: passes of the active-set loop
+  int active_set_max = 1;  // K: passes of the active-set loop
   // The loop has settled when the set stops changing and the capped impulses (mu l_n along
   // the slip direction, from the newest l_n) move by at most cap_tol * max |lambda|.
   double cap_tol = 1e-6;
   // Passes before the set settles only decide the set: while the number of changes falls they
   // solve to this relative residual (when larger than stop.tol); the settled set, and the last
-  // pass, are solved to stop.tol. 1e-4 needed 1.5x fewer Krylov iterations than 1e-6 in the
-  // material scene (doc/fix_fibre_contact.md).
-  double pass_tol = 1e-4;
+  // pass, are solved to stop.tol.
+  double pass_tol = 1e-3;
   // The loop's projected impulses are finished by at most this many projected Gauss-Seidel
   // sweeps on the full system (0: none), as long as their complementarity residual exceeds
   // sweep_tol; the sweeps stop when one moves lambda by at most sweep_tol relative to |lambda|.
+  // With solver pgs the sweeps are the whole solve.
   int sweeps = 50;
   double sweep_tol = 1e-3;
 };
+
+// The settings as one line, "name value, name value, ..." (PETSc KSPView style): the front
+// ends log it, and the doc page's defaults are this line for StepOptions{}.
+std::string describe(const StepOptions &opt);
 
 // Counts (released, capped) are global over all processes; so are the Krylov figures.
 struct StepResult {
@@ -64,6 +64,7 @@ struct StepResult {
   // in contact_solver.cpp): 0 for an exact solution of the nonsmooth step.
   double complementarity = 0;
   int sweeps = 0;  // projected Gauss-Seidel sweeps done after the loop
+  StopReason sweep_reason = StopReason::converged;  // of the sweeps (converged when none ran)
   FibreStats fibres;        // of the last pass's preconditioner
   double setup_seconds = 0;  // preconditioner builds
   double solve_seconds = 0;  // linear solves (direct: analysis, factorization and solve)
@@ -80,7 +81,8 @@ struct StepResult {
 // `comm` is the communicator the direct solver (MUMPS) runs on; the body numbering across
 // processes comes from global_body_index(). MUMPS failures propagate as DirectSolverError.
 // A solve that does not converge, or non-finite data, still gives finite lambda and dv
-// (converged = false).
+// (converged = false). With Method::pgs there is no linear pass: `converged` then says whether
+// the sweeps met sweep_tol.
 //
 // The active-set loop (design.md section 2): each pass solves the rows of the current set
 // with the capped cones' impulses in the rhs; contacts with lambda_n < 0 are released, cones

@@ -1,38 +1,10 @@
-#include "fibre/preconditioners.hpp"
+#include "fibre/preconditioner_family.hpp"
 
 #include <cmath>
 #include <memory>
 #include <stdexcept>
 
 namespace fibre {
-
-const char *to_string(PrecondKind k)
-{
-  switch (k) {
-  case PrecondKind::none:
-    return "none";
-  case PrecondKind::jacobi:
-    return "jacobi";
-  case PrecondKind::block:
-    return "block";
-  case PrecondKind::fibre:
-    return "fibre";
-  case PrecondKind::tree:
-    return "tree";
-  }
-  return "?";
-}
-
-bool parse_precond(const std::string &s, PrecondKind &k)
-{
-  for (PrecondKind c : {PrecondKind::none, PrecondKind::jacobi, PrecondKind::block,
-                        PrecondKind::fibre, PrecondKind::tree})
-    if (s == to_string(c)) {
-      k = c;
-      return true;
-    }
-  return false;
-}
 
 namespace {
 

@@ -1,0 +1,67 @@
+// The feasible set of a contact's impulses (doc/design.md section 2): lambda_n >= 0, the
+// Coulomb cone (rows 1, 2), the twisting cone (row 3) and the rolling cone (rows 4, 5), each
+// of radius coefficient * lambda_n; the projection onto it, and the complementarity residual
+// that says how far impulses are from solving the nonsmooth step.
+#pragma once
+
+#include <vector>
+
+#include <Eigen/Dense>
+
+#include "fibre/contact_model.hpp"
+#include "fibre/exchange.hpp"
+#include "fibre/system.hpp"
+
+namespace fibre {
+
+struct Cone {
+  int first, size;  // first row within the contact, 1 or 2 rows
+};
+inline constexpr Cone kCones[3] = {{1, 2}, {3, 1}, {4, 2}};
+inline int num_cones(int rows) { return rows == 6 ? 3 : 1; }
+
+inline Eigen::Vector2d cone_values(const Vector &v, Eigen::Index base, const Cone &cone)
+{
+  Eigen::Vector2d t(v[base + cone.first], 0.0);
+  if (cone.size == 2) t[1] = v[base + cone.first + 1];
+  return t;
+}
+
+inline void set_cone(Vector &v, Eigen::Index base, const Cone &cone, const Eigen::Vector2d &t)
+{
+  v[base + cone.first] = t[0];
+  if (cone.size == 2) v[base + cone.first + 1] = t[1];
+}
+
+// The cones of every contact of a system: coefficient (radius per unit normal impulse) per
+// contact and cone, and the projection.
+class Cones {
+ public:
+  Cones(const ContactSystem &sys, const FrictionParams &friction);
+  int rows() const { return rows_; }
+  double coeff(int c, int k) const { return coeff_[3 * std::size_t(c) + k]; }
+  // lambda_n >= 0 and every cone (radius from the projected normal impulse); l points to
+  // contact c's rows. Non-finite values project to 0.
+  void project(double *l, int c) const;
+
+ private:
+  int rows_;
+  std::vector<double> coeff_;
+};
+
+// Per-row scaling of the projected maps: A_ii for the normal row and the largest A_ii of each
+// cone for all its rows. One scale per cone keeps the direction of the cone's step, so a fixed
+// point has its friction along the slip (maximal dissipation). A full 6x6 block solve would
+// not: it mixes the slip into the normal row, and projected sweeps with it converge to
+// impulses whose friction is off the slip.
+std::vector<Vec6> row_scales(const ContactSystem &sys);
+
+// How far feasible impulses are from solving the contact problem A lambda = b with the cones:
+// the step of the projected Jacobi map, || lambda - P(lambda + rho / scale) ||_2 / ||lambda||_2
+// over all processes, with rho = b - A lambda. Zero exactly when lambda solves the step: active
+// normal rows solved, released contacts not pressing, sticking cones without slip, sliding
+// cones on their boundary against the slip. `sys` must have every row active.
+double complementarity(const ContactSystem &sys, const Exchange &ex, const Cones &cones,
+                       const Vector &b, const Vector &lambda, const std::vector<Vec6> &scale);
+
+}  // namespace fibre

@@ -1,0 +1,52 @@
+// The contact model that every front end shares (doc/design.md section 2): per-row compliance,
+// the effective radius and the friction, rolling and twisting coefficients of a contact.
+#pragma once
+
+#include <vector>
+
+#include "fibre/system.hpp"
+
+namespace fibre {
+
+// A zero coefficient means no resistance: those rows never enter the solve and carry no
+// impulse.
+struct FrictionParams {
+  double mu = 0.5;        // Coulomb: |lambda_t| <= mu lambda_n
+  double mu_roll = 0.0;   // rolling: |lambda_roll| <= mu_roll r_eff lambda_n
+  double mu_twist = 0.0;  // twisting: |lambda_twist| <= mu_twist r_eff lambda_n
+};
+
+// How stiff the rows are. auto: eps = factor dt^2 / m_min on every translational row, so that
+// Sigma is a fixed small fraction of the lightest body's G M^-1 G^T entry whatever the step.
+// fixed: eps_n on the normal row, eps_t on the tangential rows. The rotational rows take
+// eps_t / r_eff^2 in both modes.
+struct ComplianceParams {
+  bool automatic = true;
+  double eps_n = 0.0, eps_t = 0.0;  // fixed mode
+  double factor = 1e-2;             // automatic mode
+};
+
+// The model of one simulation: rows per contact, SPOOK damping, compliance and friction.
+struct ContactModel {
+  int rows = 6;          // 3: translational rows only; 6: with twisting and rolling
+  double damping = 2.0;  // SPOOK d = tau / h, in steps
+  ComplianceParams compliance{};
+  FrictionParams friction{};
+};
+
+// r_eff = ra rb / (ra + rb) for a pair, ra against a wall (b == nullptr).
+inline double effective_radius(double ra, const double *rb)
+{
+  return rb ? ra * *rb / (ra + *rb) : ra;
+}
+double effective_radius(const std::vector<Body> &bodies, const Contact &c);
+
+// Cone radius per unit normal impulse of cone k (0 Coulomb, 1 twisting, 2 rolling).
+double cone_coefficient(const FrictionParams &f, double r_eff, int cone);
+
+// Sets the per-row compliance of every contact (m_min: the lightest body of the simulation,
+// read in automatic mode only).
+void set_compliance(const ComplianceParams &p, double h, double m_min,
+                    const std::vector<Body> &bodies, std::vector<Contact> &contacts);
+
+}  // namespace fibre

@@ -1,0 +1,39 @@
+// Projected Gauss-Seidel (nonlinear Gauss-Seidel) on the nonsmooth contact problem
+// A lambda = b with the cones of cones.hpp: a sibling of the Krylov methods and MUMPS over the
+// same ContactSystem. Each contact in turn moves to lambda_c + rho_c / scale_c with its current
+// residual and is projected; the body velocities follow every update.
+#pragma once
+
+#include <vector>
+
+#include "fibre/cones.hpp"
+#include "fibre/exchange.hpp"
+#include "fibre/solver_control.hpp"
+
+namespace fibre {
+
+// Stop when a sweep moves lambda by at most tol relative to |lambda| (2-norms over all
+// processes), or after max_sweeps sweeps. Stagnation: no new smallest change for
+// stall_sweeps sweeps in a row.
+struct PgsControl {
+  int max_sweeps = 50;
+  double tol = 1e-3;
+  int stall_sweeps = 100;
+};
+
+struct PgsResult {
+  StopReason reason = StopReason::max_iterations;
+  int sweeps = 0;
+  double last_change = 0;  // of the last sweep, relative to |lambda|
+  bool converged() const { return reason == StopReason::converged; }
+};
+
+// Sweeps from lambda (feasible or not; it is projected contact by contact). `sys` must have
+// every row active; `scale` comes from row_scales(sys). In parallel each process sweeps its
+// own contacts; bodies shared with another process see the other's updates at the next sweep
+// (block Jacobi across processes): one reverse and one forward halo exchange per sweep.
+// A sweep that produces non-finite values is undone and stops with StopReason::non_finite.
+PgsResult pgs(const ContactSystem &sys, const Exchange &ex, const Cones &cones, const Vector &b,
+              const std::vector<Vec6> &scale, Vector &lambda, const PgsControl &control);
+
+}  // namespace fibre

@@ -1,0 +1,24 @@
+// The SPOOK step around the contact solve (doc/design.md section 2): the right-hand side from
+// the step's velocities and external forces, and the velocity change of given impulses.
+#pragma once
+
+#include "fibre/exchange.hpp"
+#include "fibre/system.hpp"
+
+namespace fibre {
+
+// Per-body velocity vector (v, omega) stacked, 6 per body.
+Vector body_velocities(const ContactSystem &sys);
+// h M^-1 f_ext per body (the free-flight velocity change).
+Vector external_velocity_change(const ContactSystem &sys);
+
+// b = -(4/h) Upsilon g - (1 - Upsilon) G v - G (h M^-1 f_ext + extra_dv).
+// extra_dv (optional, 6 per body) is a velocity change from impulses held fixed outside the
+// solve (capped friction rows); it must be complete on ghosts as well.
+Vector spook_rhs(const ContactSystem &sys, const Vector *extra_dv = nullptr);
+
+// The velocity change of impulses lambda: dv = M^-1 G^T lambda, summed over all processes and
+// complete on owned bodies and ghosts. The one place this product is written.
+Vector velocity_change(const ContactSystem &sys, const Exchange &ex, const Vector &lambda);
+
+}  // namespace fibre

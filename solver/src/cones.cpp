@@ -1,0 +1,77 @@
+#include "fibre/cones.hpp"
+
+#include <cmath>
+
+#include "fibre/kernels.hpp"
+#include "fibre/spook.hpp"
+
+namespace fibre {
+
+Cones::Cones(const ContactSystem &sys, const FrictionParams &friction)
+    : rows_(sys.rows()), coeff_(std::size_t(sys.num_contacts()) * 3, 0.0)
+{
+  for (int c = 0; c < sys.num_contacts(); ++c) {
+    const double r_eff = effective_radius(sys.bodies(), sys.contacts()[c]);
+    for (int k = 0; k < num_cones(rows_); ++k)
+      coeff_[3 * std::size_t(c) + k] = cone_coefficient(friction, r_eff, k);
+  }
+}
+
+// Hot in the sweeps: squared norms, one square root only for a cone outside.
+void Cones::project(double *l, int c) const
+{
+  l[0] = l[0] > 0 ? l[0] : 0.0;  // also NaN -> 0
+  if (!std::isfinite(l[0])) l[0] = 0.0;
+  for (int k = 0; k < num_cones(rows_); ++k) {
+    double *t = l + kCones[k].first;
+    const bool pair = kCones[k].size == 2;
+    const double radius = coeff(c, k) * l[0];
+    const double tn2 = t[0] * t[0] + (pair ? t[1] * t[1] : 0.0);
+    if (!(radius > 0) || !std::isfinite(tn2)) {
+      t[0] = 0.0;
+      if (pair) t[1] = 0.0;
+    } else if (tn2 > radius * radius) {
+      const double shrink = radius / std::sqrt(tn2);
+      t[0] *= shrink;
+      if (pair) t[1] *= shrink;
+    }
+  }
+}
+
+std::vector<Vec6> row_scales(const ContactSystem &sys)
+{
+  const int nc = sys.num_contacts();
+  std::vector<Vec6> scale(nc, Vec6::Ones());
+  for (int c = 0; c < nc; ++c) {
+    const Mat6 D = diagonal_block(sys, c);
+    scale[c][0] = D(0, 0);
+    for (int k = 0; k < num_cones(sys.rows()); ++k) {
+      const Cone &cone = kCones[k];
+      double d = D(cone.first, cone.first);
+      if (cone.size == 2) d = std::max(d, D(cone.first + 1, cone.first + 1));
+      for (int i = 0; i < cone.size; ++i) scale[c][cone.first + i] = d;
+    }
+  }
+  return scale;
+}
+
+double complementarity(const ContactSystem &sys, const Exchange &ex, const Cones &cones,
+                       const Vector &b, const Vector &lambda, const std::vector<Vec6> &scale)
+{
+  const int rows = sys.rows();
+  Vector G_dv;
+  g_apply(sys, velocity_change(sys, ex, lambda), G_dv);
+  const Vector rho = b - G_dv - sys.sigma().cwiseProduct(lambda);
+  Vector trial = lambda;
+  for (int c = 0; c < sys.num_contacts(); ++c)
+    for (int i = 0; i < rows; ++i)
+      trial[Eigen::Index(rows) * c + i] += rho[Eigen::Index(rows) * c + i] / scale[c][i];
+  for (int c = 0; c < sys.num_contacts(); ++c)
+    cones.project(trial.data() + Eigen::Index(rows) * c, c);
+  double sums[2] = {(trial - lambda).squaredNorm(), lambda.squaredNorm()};
+  ex.sum(sums, 2);
+  if (!(sums[1] > 0)) return sums[0] > 0 ? 1.0 : 0.0;
+  return std::sqrt(sums[0] / sums[1]);
+}
+
+}  // namespace fibre

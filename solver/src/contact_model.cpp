@@ -1,0 +1,31 @@
+#include "fibre/contact_model.hpp"
+
+namespace fibre {
+
+double effective_radius(const std::vector<Body> &bodies, const Contact &c)
+{
+  const double ra = bodies[c.a].radius;
+  if (c.is_wall()) return ra;
+  return effective_radius(ra, &bodies[c.b].radius);
+}
+
+double cone_coefficient(const FrictionParams &f, double r_eff, int cone)
+{
+  if (cone == 0) return f.mu;
+  return (cone == 1 ? f.mu_twist : f.mu_roll) * r_eff;
+}
+
+void set_compliance(const ComplianceParams &p, double h, double m_min,
+                    const std::vector<Body> &bodies, std::vector<Contact> &contacts)
+{
+  double eps_n = p.eps_n, eps_t = p.eps_t;
+  if (p.automatic) eps_n = eps_t = p.factor * h * h / m_min;
+  for (Contact &c : contacts) {
+    const double reff = effective_radius(bodies, c);
+    c.compliance[0] = eps_n;
+    c.compliance[1] = c.compliance[2] = eps_t;
+    for (int r = 3; r < kMaxRows; ++r) c.compliance[r] = eps_t / (reff * reff);
+  }
+}
+
+}  // namespace fibre

@@ -1,0 +1,25 @@
+#include "fibre/exchange.hpp"
+
+namespace fibre {
+
+std::vector<long> global_body_index(const Exchange &ex, int num_owned, int num_bodies,
+                                    long &total)
+{
+  const long offset = ex.exclusive_prefix_sum(num_owned);
+  total = static_cast<long>(ex.sum(static_cast<double>(num_owned)));
+  // Carry the ids through a per-body vector (doubles hold integers below 2^53 exactly).
+  Vector ids = Vector::Zero(Eigen::Index(kBodyDofs) * num_bodies);
+  for (int i = 0; i < num_owned; ++i) ids[6 * i] = static_cast<double>(offset + i);
+  ex.forward(ids);
+  std::vector<long> index(num_bodies);
+  for (int i = 0; i < num_bodies; ++i) index[i] = static_cast<long>(ids[6 * i]);
+  return index;
+}
+
+const Exchange &serial_exchange()
+{
+  static const SerialExchange ex;
+  return ex;
+}
+
+}  // namespace fibre
