@@ -1,8 +1,6 @@
 #include "fibre/step_solver.hpp"
 
-#include <chrono>
 #include <cmath>
-#include <cstdio>
 #include <limits>
 
 #include "fibre/cones.hpp"
@@ -10,16 +8,13 @@
 #include "fibre/kernels.hpp"
 #include "fibre/pgs.hpp"
 #include "fibre/spook.hpp"
+#include "fibre/text.hpp"
 
 namespace fibre {
 
 std::string describe(const StepOptions &opt)
 {
-  auto g = [](double x) {
-    char buf[32];
-    std::snprintf(buf, sizeof(buf), "%.6g", x);
-    return std::string(buf);
-  };
+  const auto g = format_g;
   return std::string("form ") + to_string(opt.form) + ", solver " + to_string(opt.solver) +
          ", precond " + to_string(opt.precond.kind) + ", weight " +
          to_string(opt.precond.weight) + ", tol " + g(opt.stop.tol) + ", pass_tol " +
@@ -30,13 +25,6 @@ std::string describe(const StepOptions &opt)
 }
 
 namespace {
-
-using Clock = std::chrono::steady_clock;
-
-double seconds_since(Clock::time_point t0)
-{
-  return std::chrono::duration<double>(Clock::now() - t0).count();
-}
 
 // One contact's place in the active set. A capped cone holds its impulse on the boundary,
 // radius * dir, outside the solve. Releasing and capping may be undone kMaxReversals times per
