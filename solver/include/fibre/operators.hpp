@@ -14,7 +14,7 @@ namespace fibre {
 enum class Form { contact, body };
 template <>
 struct EnumNames<Form> {
-  static constexpr EnumName<Form> table[] = {{Form::contact, "contact"}, {Form::body, "body"}};
+  static constexpr EnumName<Form> table[] = {{Form::body, "body"}, {Form::contact, "contact"}};
 };
 
 // Symmetric positive definite operator with its own (global) inner product.

@@ -1,5 +1,5 @@
-// fibre::Exchange on LAMMPS halo communication (see fix_fibre_exchange.h).
-#include "fix_fibre_exchange.h"
+// fibre::Exchange on LAMMPS halo communication (see lammps_exchange.h).
+#include "lammps_exchange.h"
 
 #include <algorithm>
 

@@ -1,0 +1,219 @@
+#include "fibre_detect.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "atom.h"
+#include "domain.h"
+#include "error.h"
+#include "force.h"
+#include "lammps_exchange.h"
+#include "neigh_list.h"
+#include "neighbor.h"
+#include "pair.h"
+#include "region.h"
+
+using namespace LAMMPS_NS;
+
+namespace fibre_lmp {
+
+LammpsDetection::LammpsDetection(LAMMPS *lmp, int groupbit, LammpsExchange &exchange)
+    : Pointers(lmp), groupbit_(groupbit), exchange_(exchange)
+{
+}
+
+void LammpsDetection::init_walls(const std::vector<fibre::WallSpec> &walls)
+{
+  walls_ = walls;
+  regions_.assign(walls.size(), -1);
+  for (std::size_t w = 0; w < walls.size(); ++w) {
+    if (walls[w].kind != fibre::WallKind::region) continue;
+    const std::string &id = walls[w].region_id;
+    regions_[w] = domain->find_region(id);
+    if (regions_[w] < 0)
+      error->all(FLERR, "Region ID '" + id + "' for fix fibre_contact 'wall region' does not exist");
+    if (domain->regions[regions_[w]]->dynamic)
+      error->all(FLERR, "Fix fibre_contact does not support moving region '" + id +
+                            "' (walls must be at rest)");
+  }
+}
+
+std::vector<fibre::Body> LammpsDetection::bodies()
+{
+  const int nlocal = atom->nlocal, nall = nlocal + atom->nghost;
+  const int *mask = atom->mask;
+  const tagint *tag = atom->tag;
+  double **x = atom->x;
+
+  // Owned atoms by tag, ghosts by tag and position: the system does not depend on the atoms'
+  // storage order.
+  std::vector<int> body_atom, ghosts;
+  for (int i = 0; i < nlocal; ++i)
+    if (mask[i] & groupbit_) body_atom.push_back(i);
+  for (int i = nlocal; i < nall; ++i)
+    if (mask[i] & groupbit_) ghosts.push_back(i);
+  std::sort(body_atom.begin(), body_atom.end(), [tag](int a, int b) { return tag[a] < tag[b]; });
+  std::sort(ghosts.begin(), ghosts.end(), [tag, x](int a, int b) {
+    if (tag[a] != tag[b]) return tag[a] < tag[b];
+    for (int d = 0; d < 3; ++d)
+      if (x[a][d] != x[b][d]) return x[a][d] < x[b][d];
+    return a < b;
+  });
+  const int nowned = static_cast<int>(body_atom.size());
+  body_atom.insert(body_atom.end(), ghosts.begin(), ghosts.end());
+  const int nbody = static_cast<int>(body_atom.size());
+  exchange_.set_bodies(body_atom, nowned);
+  atom_body_.assign(nall, -1);
+  for (int k = 0; k < nbody; ++k) atom_body_[body_atom[k]] = k;
+
+  double **v = atom->v, **omega = atom->omega, **f = atom->f, **torque = atom->torque;
+  fibre::Vector vel = fibre::Vector::Zero(6 * Eigen::Index(nbody));
+  fibre::Vector frc = fibre::Vector::Zero(6 * Eigen::Index(nbody));
+  for (int k = 0; k < nowned; ++k) {
+    const int i = body_atom[k];
+    for (int d = 0; d < 3; ++d) {
+      vel[6 * k + d] = v[i][d];
+      vel[6 * k + 3 + d] = omega[i][d];
+      frc[6 * k + d] = f[i][d];
+      frc[6 * k + 3 + d] = torque[i][d];
+    }
+  }
+  exchange_.forward(vel);
+  exchange_.forward(frc);
+
+  std::vector<fibre::Body> out(nbody);
+  for (int k = 0; k < nbody; ++k) {
+    const int i = body_atom[k];
+    fibre::Body &b = out[k];
+    b.mass = atom->rmass[i];
+    b.radius = atom->radius[i];
+    b.x = fibre::Vec3(x[i][0], x[i][1], x[i][2]);
+    b.v = vel.segment<3>(6 * k);
+    b.omega = vel.segment<3>(6 * k + 3);
+    b.force = frc.segment<3>(6 * k);
+    b.torque = frc.segment<3>(6 * k + 3);
+  }
+  return out;
+}
+
+std::vector<fibre::DetectedContact> LammpsDetection::contacts(
+    const std::vector<fibre::Body> &bodies, double h, double damping) const
+{
+  std::vector<fibre::DetectedContact> found;
+  pair_contacts(bodies, h, damping, found);
+  wall_contacts(bodies, h, damping, found);
+  fibre::sort_contacts(found);
+  return found;
+}
+
+// Every contact is kept by exactly one process: a pair of two owned atoms is listed once; with
+// newton_pair on a pair with a ghost is listed on one process only; with newton_pair off it is
+// listed on both and the process owning the atom with the smaller tag keeps it.
+void LammpsDetection::pair_contacts(const std::vector<fibre::Body> &bodies, double h,
+                                    double damping,
+                                    std::vector<fibre::DetectedContact> &found) const
+{
+  NeighList *list = force->pair->list;
+  const int nlocal = atom->nlocal;
+  const tagint *tag = atom->tag;
+  double **x = atom->x;
+  const double *radius = atom->radius;
+  const bool newton_pair = force->newton_pair != 0;
+  const double reach = neighbor->skin;  // pairs beyond radsum + skin are not in the list
+
+  for (int ii = 0; ii < list->inum; ++ii) {
+    const int i = list->ilist[ii];
+    const int *jlist = list->firstneigh[i];
+    for (int jj = 0; jj < list->numneigh[i]; ++jj) {
+      const int j = jlist[jj] & NEIGHMASK;
+      const int bi = atom_body_[i], bj = atom_body_[j];
+      if (bi < 0 && bj < 0) continue;
+      if (tag[i] == tag[j]) continue;  // a periodic image of itself
+      if (j >= nlocal && !newton_pair && tag[i] > tag[j]) continue;
+      const double dx = x[i][0] - x[j][0], dy = x[i][1] - x[j][1], dz = x[i][2] - x[j][2];
+      const double rsq = dx * dx + dy * dy + dz * dz;
+      const double radsum = radius[i] + radius[j];
+      if (rsq >= (radsum + reach) * (radsum + reach)) continue;
+
+      // the atom with the smaller tag stores the warm start if it is owned here
+      const int low = tag[i] < tag[j] ? i : j, high = low == i ? j : i;
+      fibre::DetectedContact fc;
+      fc.store = low < nlocal ? low : high;
+      if (bi >= 0 && bj >= 0) {
+        const int a = tag[i] < tag[j] ? bi : bj, b = a == bi ? bj : bi;
+        fc.contact = fibre::sphere_sphere_contact(bodies, a, b);
+        if (!fibre::is_contact(bodies[a], &bodies[b], fc.contact.normal, fc.contact.gap, h,
+                               damping))
+          continue;
+        fc.tag_a = tag[low];
+        fc.partner = static_cast<double>(tag[high]);
+      } else {
+        // one atom is outside the group: a fixed spherical obstacle
+        const int g = bi >= 0 ? i : j, o = g == i ? j : i;
+        const double sign = g == i ? 1.0 : -1.0, dist = std::sqrt(rsq);
+        fibre::Vec3 n(sign * dx, sign * dy, sign * dz);
+        n = dist > 0.0 ? fibre::Vec3(n / dist) : fibre::Vec3::UnitZ();
+        fc.contact = fibre::sphere_wall_contact(bodies, atom_body_[g], n, dist - radius[o]);
+        if (!fibre::is_contact(bodies[atom_body_[g]], nullptr, n, fc.contact.gap, h, damping))
+          continue;
+        fc.tag_a = tag[g];
+        fc.partner = static_cast<double>(tag[o]);
+      }
+      fc.key = tag[fc.store] == fc.tag_a ? fc.partner : static_cast<double>(fc.tag_a);
+      found.push_back(fc);
+    }
+  }
+}
+
+void LammpsDetection::add_wall_contact(const std::vector<fibre::Body> &bodies, int body,
+                                       const fibre::Vec3 &n, double distance, int wall, int sub,
+                                       double h, double damping,
+                                       std::vector<fibre::DetectedContact> &found) const
+{
+  if (!fibre::is_contact(bodies[body], nullptr, n, distance - bodies[body].radius, h, damping))
+    return;
+  fibre::DetectedContact fc;
+  fc.contact = fibre::sphere_wall_contact(bodies, body, n, distance);
+  fc.store = exchange_.body_atom()[body];
+  fc.tag_a = atom->tag[fc.store];
+  fc.partner = fibre::wall_key(wall, sub);
+  fc.key = fc.partner;
+  fc.wall = wall;
+  found.push_back(fc);
+}
+
+void LammpsDetection::wall_contacts(const std::vector<fibre::Body> &bodies, double h,
+                                    double damping,
+                                    std::vector<fibre::DetectedContact> &found) const
+{
+  const int nowned = exchange_.num_owned();
+  const double skin = neighbor->skin;
+  for (int w = 0; w < static_cast<int>(walls_.size()); ++w) {
+    if (walls_[w].kind != fibre::WallKind::region) {
+      for (int k = 0; k < nowned; ++k) {
+        fibre::PlaneHit hits[2];
+        const int n = fibre::plane_hits(walls_[w], bodies[k], skin, hits);
+        for (int s = 0; s < n; ++s)
+          add_wall_contact(bodies, k, hits[s].normal, hits[s].distance, w, hits[s].sub, h, damping,
+                           found);
+      }
+      continue;
+    }
+    Region *region = domain->regions[regions_[w]];
+    region->prematch();
+    for (int k = 0; k < nowned; ++k) {
+      const fibre::Body &b = bodies[k];
+      const int nc = region->surface(b.x[0], b.x[1], b.x[2],
+                                     fibre::region_cutoff(b, h, damping, skin));
+      for (int c = 0; c < nc; ++c) {
+        const Region::Contact &rc = region->contact[c];
+        if (!(rc.r > 0.0)) continue;
+        const fibre::Vec3 n(rc.delx / rc.r, rc.dely / rc.r, rc.delz / rc.r);
+        add_wall_contact(bodies, k, n, rc.r, w, std::min(rc.iwall, fibre::kWallKeyStride - 1), h,
+                         damping, found);
+      }
+    }
+  }
+}
+
+}  // namespace fibre_lmp

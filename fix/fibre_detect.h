@@ -1,0 +1,46 @@
+// Contact detection for fix fibre_contact on LAMMPS data: the group's atoms as bodies (owned
+// ones sorted by tag, then ghosts), sphere pairs from the granular pair style's neighbour
+// list, spheres outside the group as fixed obstacles, plane and region walls. The criteria
+// and plane geometry are the library's (fibre/detection.hpp).
+#pragma once
+
+#include <vector>
+
+#include "fibre/detection.hpp"
+#include "pointers.h"
+
+namespace fibre_lmp {
+
+class LammpsExchange;
+
+class LammpsDetection : protected LAMMPS_NS::Pointers {
+ public:
+  LammpsDetection(LAMMPS_NS::LAMMPS *lmp, int groupbit, LammpsExchange &exchange);
+
+  // Resolves region walls (region IDs to regions); call from init().
+  void init_walls(const std::vector<fibre::WallSpec> &walls);
+
+  // The step's bodies: velocities and external forces of owned atoms, forwarded to ghosts.
+  std::vector<fibre::Body> bodies();
+
+  // Every contact this process keeps, in the library's order (fibre::sort_contacts).
+  std::vector<fibre::DetectedContact> contacts(const std::vector<fibre::Body> &bodies, double h,
+                                               double damping) const;
+
+ private:
+  void pair_contacts(const std::vector<fibre::Body> &bodies, double h, double damping,
+                     std::vector<fibre::DetectedContact> &found) const;
+  void wall_contacts(const std::vector<fibre::Body> &bodies, double h, double damping,
+                     std::vector<fibre::DetectedContact> &found) const;
+  void add_wall_contact(const std::vector<fibre::Body> &bodies, int body, const fibre::Vec3 &n,
+                        double distance, int wall, int sub, double h, double damping,
+                        std::vector<fibre::DetectedContact> &found) const;
+
+  int groupbit_;
+  LammpsExchange &exchange_;
+  std::vector<fibre::WallSpec> walls_;
+  std::vector<int> regions_;  // per wall: region index, or -1
+  std::vector<int> atom_body_;  // local atom -> body index, -1 if not a body
+};
+
+}  // namespace fibre_lmp

@@ -1,0 +1,174 @@
+#include "fibre_output.h"
+
+#include <cmath>
+#include <cstdio>
+#include <exception>
+
+#include "comm.h"
+#include "error.h"
+#include "fibre/system_io.hpp"
+#include "fibre/text.hpp"
+#include "memory.h"
+#include "update.h"
+
+using namespace LAMMPS_NS;
+
+namespace fibre_lmp {
+
+FibreOutput::~FibreOutput()
+{
+  memory->destroy(local_array_);
+}
+
+double FibreOutput::count_contacts(const std::vector<fibre::DetectedContact> &found)
+{
+  double sums[2] = {double(found.size()), 0.0};
+  double deepest = 0.0;
+  for (const fibre::DetectedContact &fc : found) {
+    if (fc.contact.is_wall()) sums[1] += 1.0;
+    deepest = std::max(deepest, -fc.contact.gap);
+  }
+  MPI_Allreduce(MPI_IN_PLACE, sums, 2, MPI_DOUBLE, MPI_SUM, world);
+  MPI_Allreduce(MPI_IN_PLACE, &deepest, 1, MPI_DOUBLE, MPI_MAX, world);
+  stats_[V_CONTACTS] = sums[0];
+  stats_[V_WALL_CONTACTS] = sums[1];
+  stats_[V_OVERLAP] = deepest;
+  return sums[0];
+}
+
+void FibreOutput::report_solve(const fibre::StepResult &res)
+{
+  stats_[V_ITER] = res.total_iterations;
+  stats_[V_RESID] = res.rel_residual;
+  stats_[V_PASSES] = res.active_set_passes;
+  stats_[V_CONVERGED] = res.converged ? 1.0 : 0.0;
+  stats_[V_COMPLEMENTARITY] = res.complementarity;
+  stats_[V_SWEEPS] = res.sweeps;
+
+  double sums[3] = {double(res.fibres.num_fibres), double(res.fibres.contacts_in_fibres),
+                    double(res.fibres.num_contacts)};
+  MPI_Allreduce(MPI_IN_PLACE, sums, 3, MPI_DOUBLE, MPI_SUM, world);
+  stats_[V_FIBRES] = sums[0];
+  stats_[V_FIBRE_FRACTION] = sums[2] > 0 ? sums[1] / sums[2] : 0.0;
+  double times[3] = {res.setup_seconds, res.solve_seconds, res.sweep_seconds};
+  MPI_Allreduce(MPI_IN_PLACE, times, 3, MPI_DOUBLE, MPI_MAX, world);
+  stats_[V_SETUP] = times[0];
+  stats_[V_SOLVE] = times[1];
+  stats_[V_SWEEP_TIME] = times[2];
+
+  if (!res.converged) {
+    ++nonconverged_total_;
+    ++nonconverged_since_warning_;
+    const bigint step = update->ntimestep;
+    if (last_warning_step_ < 0 || step - last_warning_step_ >= 100) {
+      if (comm->me == 0)
+        error->warning(FLERR, "Fix fibre_contact: contact solve did not converge at step " +
+                                  std::to_string(static_cast<long long>(step)) + " (" +
+                                  fibre::to_string(res.reason) + ", " +
+                                  std::to_string(res.iterations) + " iterations, relative "
+                                  "residual " + fibre::format_g(res.rel_residual) + "); " +
+                                  std::to_string(static_cast<long long>(
+                                      nonconverged_since_warning_)) +
+                                  " non-converged steps since the last warning, " +
+                                  std::to_string(static_cast<long long>(nonconverged_total_)) +
+                                  " in all");
+      last_warning_step_ = step;
+      nonconverged_since_warning_ = 0;
+    }
+  }
+  stats_[V_NONCONVERGED] = static_cast<double>(nonconverged_total_);
+}
+
+void FibreOutput::fill_local(const std::vector<fibre::DetectedContact> &found,
+                             const fibre::Vector *lambda, int rows, double **&array_local,
+                             int &size_local_rows)
+{
+  const int nc = static_cast<int>(found.size());
+  if (nc > maxlocal_) {
+    maxlocal_ = std::max(nc, 2 * maxlocal_);
+    memory->destroy(local_array_);
+    memory->create(local_array_, maxlocal_, kLocalColumns, "fibre_contact:local");
+  }
+  array_local = local_array_;
+  size_local_rows = nc;
+  for (int c = 0; c < nc; ++c) {
+    const fibre::DetectedContact &fc = found[c];
+    double *row = local_array_[c];
+    row[0] = static_cast<double>(fc.tag_a);
+    row[1] = fc.partner > 0 ? fc.partner : 0.0;
+    row[2] = fc.wall + 1;
+    row[3] = fc.contact.gap;
+    for (int d = 4; d < kLocalColumns; ++d) row[d] = 0.0;
+    if (!lambda) continue;
+    const double *l = lambda->data() + Eigen::Index(rows) * c;
+    row[4] = l[0];
+    row[5] = std::hypot(l[1], l[2]);
+    if (rows == 6) {
+      row[6] = std::hypot(l[4], l[5]);
+      row[7] = std::fabs(l[3]);
+    }
+  }
+}
+
+void FibreOutput::export_step(const std::string &prefix, const fibre::ContactSystem &sys,
+                              const std::vector<fibre::DetectedContact> &found,
+                              const fibre::Vector *lambda)
+{
+  const std::string base = prefix + "." +
+                           std::to_string(static_cast<long long>(update->ntimestep)) + "." +
+                           std::to_string(comm->me);
+  try {
+    fibre::write_system_file(base + ".sys", sys);
+  } catch (std::exception &e) {
+    error->one(FLERR, "Fix fibre_contact could not write export file " + base + ".sys: " +
+                          e.what());
+  }
+  FILE *fp = std::fopen((base + ".lambda").c_str(), "w");
+  if (!fp) error->one(FLERR, "Fix fibre_contact could not write export file " + base + ".lambda");
+  const int rows = sys.rows();
+  std::fprintf(fp, "# fibre_contact impulses, step %lld, process %d: %d contacts, %d rows each\n",
+               static_cast<long long>(update->ntimestep), comm->me, sys.num_contacts(), rows);
+  std::fprintf(fp, "# contact tag_a tag_b(0 = wall) wall(0 = none) lambda_0 .. lambda_%d\n",
+               rows - 1);
+  for (int c = 0; c < sys.num_contacts(); ++c) {
+    const fibre::DetectedContact &fc = found[c];
+    std::fprintf(fp, "%d %lld %lld %d", c, static_cast<long long>(fc.tag_a),
+                 static_cast<long long>(fc.partner > 0 ? fc.partner : 0.0), fc.wall + 1);
+    for (int r = 0; r < rows; ++r)
+      std::fprintf(fp, " %.17g", lambda ? (*lambda)[Eigen::Index(rows) * c + r] : 0.0);
+    std::fprintf(fp, "\n");
+  }
+  std::fclose(fp);
+}
+
+// Counters and the last step's figures.
+void FibreOutput::write_restart(FILE *fp) const
+{
+  double list[2 + V_SIZE];
+  list[0] = kRestartFormat;
+  list[1] = static_cast<double>(nonconverged_total_);
+  for (int k = 0; k < V_SIZE; ++k) list[2 + k] = stats_[k];
+  if (comm->me == 0) {
+    const int size = static_cast<int>(sizeof(list));
+    std::fwrite(&size, sizeof(int), 1, fp);
+    std::fwrite(list, sizeof(double), 2 + V_SIZE, fp);
+  }
+}
+
+void FibreOutput::read_restart(const char *buf)
+{
+  const double *list = reinterpret_cast<const double *>(buf);
+  if (list[0] != kRestartFormat) {
+    error->warning(FLERR, std::string("Fix fibre_contact: restart data of another format ignored"));
+    return;
+  }
+  nonconverged_total_ = static_cast<bigint>(list[1]);
+  for (int k = 0; k < V_SIZE; ++k) stats_[k] = list[2 + k];
+}
+
+double FibreOutput::memory_bytes() const
+{
+  return double(maxlocal_) * kLocalColumns * sizeof(double);
+}
+
+}  // namespace fibre_lmp

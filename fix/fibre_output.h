@@ -1,0 +1,58 @@
+// What fix fibre_contact reports: the global vector f_ID[1..15], the local array (one row per
+// contact kept by this process), the non-convergence warnings and the system exports.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "fibre/detection.hpp"
+#include "fibre/step_solver.hpp"
+#include "pointers.h"
+
+namespace fibre_lmp {
+
+// Entries of the global vector (f_ID[k + 1]); the doc page's "Restart, fix_modify, output"
+// lists them.
+enum Stat {
+  V_ITER = 0, V_RESID, V_CONTACTS, V_FIBRES, V_FIBRE_FRACTION, V_PASSES, V_OVERLAP, V_SETUP,
+  V_SOLVE, V_CONVERGED, V_WALL_CONTACTS, V_NONCONVERGED, V_COMPLEMENTARITY, V_SWEEPS,
+  V_SWEEP_TIME, V_SIZE
+};
+
+class FibreOutput : protected LAMMPS_NS::Pointers {
+ public:
+  static constexpr int kLocalColumns = 8;
+  static constexpr double kRestartFormat = 2.0;  // 2: 15 global values
+
+  explicit FibreOutput(LAMMPS_NS::LAMMPS *lmp) : Pointers(lmp) {}
+  ~FibreOutput() override;
+
+  double stat(int n) const { return n >= 0 && n < V_SIZE ? stats_[n] : 0.0; }
+
+  // Contacts, wall contacts and the deepest overlap over all processes; returns the number
+  // of contacts.
+  double count_contacts(const std::vector<fibre::DetectedContact> &found);
+  // The solve's figures (summed or maximised over processes), with a warning at most every
+  // 100 steps while solves fail. A step without contacts reports an empty, converged result.
+  void report_solve(const fibre::StepResult &res);
+  // One row per contact: tags, wall, gap, |normal|, |friction|, |rolling|, |twisting| impulse.
+  void fill_local(const std::vector<fibre::DetectedContact> &found, const fibre::Vector *lambda,
+                  int rows, double **&array_local, int &size_local_rows);
+  // prefix.STEP.RANK.sys (the system) and .lambda (the impulses with the atoms of every contact).
+  void export_step(const std::string &prefix, const fibre::ContactSystem &sys,
+                   const std::vector<fibre::DetectedContact> &found, const fibre::Vector *lambda);
+
+  void write_restart(FILE *fp) const;
+  void read_restart(const char *buf);
+  double memory_bytes() const;
+
+ private:
+  double stats_[V_SIZE] = {};
+  LAMMPS_NS::bigint nonconverged_total_ = 0;
+  LAMMPS_NS::bigint nonconverged_since_warning_ = 0;
+  LAMMPS_NS::bigint last_warning_step_ = -1;
+  int maxlocal_ = 0;
+  double **local_array_ = nullptr;
+};
+
+}  // namespace fibre_lmp

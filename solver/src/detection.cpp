@@ -1,0 +1,55 @@
+#include "fibre/detection.hpp"
+
+#include <algorithm>
+
+namespace fibre {
+
+bool is_contact(const Body &a, const Body *b, const Vec3 &n, double gap, double h,
+                double damping)
+{
+  const double rmin = b ? std::min(a.radius, b->radius) : a.radius;
+  const double margin = kContactMargin * rmin;
+  if (gap < margin) return true;
+  Vec3 rel = a.v + (h / a.mass) * a.force;
+  if (b) rel -= b->v + (h / b->mass) * b->force;
+  const double approach = -n.dot(rel);
+  return approach > 0.0 && gap < margin + (damping + 1.0) * h * approach;
+}
+
+double region_cutoff(const Body &b, double h, double damping, double skin)
+{
+  const Vec3 vfree = b.v + (h / b.mass) * b.force;
+  return b.radius * (1.0 + kContactMargin) + std::min(skin, (damping + 1.0) * h * vfree.norm());
+}
+
+int plane_hits(const WallSpec &wall, const Body &b, double reach, PlaneHit hits[2])
+{
+  const int dim = wall.axis();
+  int n = 0;
+  if (wall.has_lo) {
+    const double distance = b.x[dim] - wall.lo;
+    if (distance - b.radius < reach) {
+      hits[n] = PlaneHit{Vec3::Zero(), distance, 0};
+      hits[n++].normal[dim] = 1.0;
+    }
+  }
+  if (wall.has_hi) {
+    const double distance = wall.hi - b.x[dim];
+    if (distance - b.radius < reach) {
+      hits[n] = PlaneHit{Vec3::Zero(), distance, 1};
+      hits[n++].normal[dim] = -1.0;
+    }
+  }
+  return n;
+}
+
+void sort_contacts(std::vector<DetectedContact> &found)
+{
+  std::sort(found.begin(), found.end(), [](const DetectedContact &p, const DetectedContact &q) {
+    if (p.tag_a != q.tag_a) return p.tag_a < q.tag_a;
+    if (p.partner != q.partner) return p.partner < q.partner;
+    return p.contact.gap < q.contact.gap;
+  });
+}
+
+}  // namespace fibre

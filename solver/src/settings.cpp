@@ -1,0 +1,203 @@
+#include "fibre/settings.hpp"
+
+#include "fibre/text.hpp"
+
+namespace fibre {
+
+namespace {
+
+// Reads keyword values from args; every failure names the keyword's expected form.
+class Reader {
+ public:
+  explicit Reader(const std::vector<std::string> &args) : args_(args) {}
+
+  bool has(std::size_t i) const { return i < args_.size(); }
+  const std::string &at(std::size_t i) const { return args_[i]; }
+
+  [[noreturn]] static void illegal(const std::string &expected, const std::string *got = nullptr)
+  {
+    std::string msg = "expected " + expected;
+    if (got) msg += ", got '" + *got + "'";
+    throw SettingsError(msg);
+  }
+
+  double number(std::size_t i, const std::string &expected) const
+  {
+    if (!has(i)) illegal(expected);
+    double value = 0.0;
+    if (!to_double(args_[i], value)) illegal(expected, &args_[i]);
+    return value;
+  }
+
+  double positive(std::size_t i, const std::string &expected) const
+  {
+    const double value = number(i, expected);
+    if (!(value > 0.0)) illegal(expected, &args_[i]);
+    return value;
+  }
+
+  long integer(std::size_t i, const std::string &expected, long lo, long hi) const
+  {
+    if (!has(i)) illegal(expected);
+    long value = 0;
+    if (!to_long(args_[i], value) || value < lo || value > hi) illegal(expected, &args_[i]);
+    return value;
+  }
+
+  template <class E>
+  E name(std::size_t i, const std::string &key) const
+  {
+    const std::string expected = "'" + key + " " + choices<E>() + "'";
+    if (!has(i)) illegal(expected);
+    E value{};
+    if (!parse(args_[i], value)) illegal(expected, &args_[i]);
+    return value;
+  }
+
+ private:
+  const std::vector<std::string> &args_;
+};
+
+// "wall xplane|yplane|zplane <lo|NULL> <hi|NULL>" or "wall region <region-ID>" at args[i];
+// returns the number of words read.
+std::size_t read_wall(const Reader &in, std::size_t i, WallSpec &w)
+{
+  const std::string e =
+      "'wall xplane|yplane|zplane <lo|NULL> <hi|NULL>' or 'wall region <region-ID>'";
+  if (!in.has(i + 1)) Reader::illegal(e);
+  const std::string &kind = in.at(i + 1);
+  if (!parse(kind, w.kind)) Reader::illegal(e, &kind);
+  if (w.kind == WallKind::region) {
+    if (!in.has(i + 2)) Reader::illegal("'wall region <region-ID>'");
+    w.region_id = in.at(i + 2);
+    return 3;
+  }
+  const std::string ep = "'wall " + kind + " <lo|NULL> <hi|NULL>'";
+  if (!in.has(i + 3)) Reader::illegal(ep);
+  const std::string &lo = in.at(i + 2), &hi = in.at(i + 3);
+  if (lo != "NULL") {
+    if (!to_double(lo, w.lo)) Reader::illegal(ep, &lo);
+    w.has_lo = true;
+  }
+  if (hi != "NULL") {
+    if (!to_double(hi, w.hi)) Reader::illegal(ep, &hi);
+    w.has_hi = true;
+  }
+  if (!w.has_lo && !w.has_hi) Reader::illegal(ep + " with at least one of lo and hi a number");
+  const std::string both = lo + " " + hi;
+  if (w.has_lo && w.has_hi && !(w.lo < w.hi)) Reader::illegal(ep + " with lo < hi", &both);
+  return 4;
+}
+
+// The solver keywords; returns the words read, 0 when `key` is not one of them.
+std::size_t read_solver_keyword(const Reader &in, std::size_t i, StepOptions &opt)
+{
+  const std::string &key = in.at(i);
+  if (key == "form") opt.form = in.name<Form>(i + 1, key);
+  else if (key == "solver") opt.solver = in.name<Method>(i + 1, key);
+  else if (key == "precond") opt.precond.kind = in.name<PrecondKind>(i + 1, key);
+  else if (key == "weight") opt.precond.weight = in.name<EdgeWeight>(i + 1, key);
+  else if (key == "tol") opt.stop.tol = in.positive(i + 1, "'tol <positive number>'");
+  else if (key == "pass_tol") opt.pass_tol = in.positive(i + 1, "'pass_tol <positive number>'");
+  else if (key == "maxiter")
+    opt.stop.max_iter =
+        static_cast<int>(in.integer(i + 1, "'maxiter <positive integer>'", 1, 100000000));
+  else if (key == "active_set")
+    opt.active_set_max =
+        static_cast<int>(in.integer(i + 1, "'active_set <positive integer>'", 1, 1000));
+  else if (key == "sweeps")
+    opt.sweeps =
+        static_cast<int>(in.integer(i + 1, "'sweeps <non-negative integer>'", 0, 100000));
+  else if (key == "sweep_tol") opt.sweep_tol = in.positive(i + 1, "'sweep_tol <positive number>'");
+  else return 0;
+  return 2;
+}
+
+// The contact model's keywords (friction included); 0 when `key` is not one of them.
+std::size_t read_model_keyword(const Reader &in, std::size_t i, Settings &s)
+{
+  const std::string &key = in.at(i);
+  if (key == "compliance") {
+    const std::string e = "'compliance auto' or 'compliance <eps_n> <eps_t>' (positive numbers)";
+    if (!in.has(i + 1)) Reader::illegal(e);
+    if (in.at(i + 1) == "auto") {
+      s.model.compliance.automatic = true;
+      return 2;
+    }
+    const double en = in.positive(i + 1, e);
+    const double et = in.positive(i + 2, e);
+    s.model.compliance.automatic = false;
+    s.model.compliance.eps_n = en;
+    s.model.compliance.eps_t = et;
+    return 3;
+  }
+  if (key == "damping") {
+    s.model.damping = in.positive(i + 1, "'damping <positive number of steps>'");
+    return 2;
+  }
+  if (key == "mu" || key == "mu_roll" || key == "mu_twist") {
+    const std::string e = "'" + key + " <non-negative number>'";
+    const double v = in.number(i + 1, e);
+    if (!(v >= 0.0)) Reader::illegal(e, &in.at(i + 1));
+    FrictionParams &f = s.step.friction;
+    (key == "mu" ? f.mu : key == "mu_roll" ? f.mu_roll : f.mu_twist) = v;
+    return 2;
+  }
+  if (key == "rows") {
+    const std::string e = "'rows 3|6'";
+    long v = 0;
+    if (!in.has(i + 1)) Reader::illegal(e);
+    if (!to_long(in.at(i + 1), v) || (v != 3 && v != 6)) Reader::illegal(e, &in.at(i + 1));
+    s.model.rows = static_cast<int>(v);
+    return 2;
+  }
+  return 0;
+}
+
+}  // namespace
+
+Settings parse_settings(const std::vector<std::string> &args)
+{
+  Settings s;
+  const Reader in(args);
+  std::size_t i = 0;
+  while (i < args.size()) {
+    const std::string &key = args[i];
+    std::size_t used = read_solver_keyword(in, i, s.step);
+    if (!used) used = read_model_keyword(in, i, s);
+    if (!used && key == "wall") {
+      WallSpec w;
+      used = read_wall(in, i, w);
+      s.walls.push_back(w);
+    }
+    if (!used && key == "export") {
+      const std::string e = "'export <N> <file-prefix>' (N a positive integer)";
+      s.export_every = static_cast<int>(in.integer(i + 1, e, 1, 2000000000L));
+      if (!in.has(i + 2)) Reader::illegal(e);
+      s.export_prefix = args[i + 2];
+      used = 3;
+    }
+    if (!used)
+      Reader::illegal("a keyword (form, solver, precond, weight, tol, pass_tol, maxiter, "
+                      "compliance, damping, mu, mu_roll, mu_twist, rows, active_set, sweeps, "
+                      "sweep_tol, wall, export)",
+                      &key);
+    i += used;
+  }
+  const FrictionParams &f = s.step.friction;
+  if (s.model.rows == 3 && (f.mu_roll > 0.0 || f.mu_twist > 0.0))
+    throw SettingsError("mu_roll and mu_twist need 'rows 6' (rows 3 has no rotational rows)");
+  return s;
+}
+
+std::string describe(const Settings &s)
+{
+  const ComplianceParams &c = s.model.compliance;
+  std::string out = describe(s.step) + ", rows " + std::to_string(s.model.rows) + ", damping " +
+                    format_g(s.model.damping) + ", compliance ";
+  if (c.automatic) out += "auto (" + format_g(c.factor) + " dt^2 / m_min)";
+  else out += format_g(c.eps_n) + " " + format_g(c.eps_t);
+  return out;
+}
+
+}  // namespace fibre
