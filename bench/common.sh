@@ -1,4 +1,51 @@
+# shellcheck shell=bash
 # Shared by the end-to-end scripts (e2e_speed.sh, mpi_scaling.sh); sourced, not run.
+# shellcheck disable=SC2034  # the variables set here are the caller's
+
+# The usage of the calling script: its head comment (the lines from 2 to the first line that
+# is not a comment), without the '# '.
+usage() {  # script
+  awk 'NR == 1 { next } !/^#/ { exit } { sub(/^# ?/, ""); print }' "$1"
+}
+
+# The options of the end-to-end scripts, into the variables of the same name (the caller sets
+# the defaults first): --deck, --N, --tend, --np, --lmp, --work, --extra, --mpirun-flags
+# (mpirun_flags); -h/--help prints the caller's usage and exits 0, anything else exits 2.
+parse_options() {  # script "$@"
+  local script=$1
+  shift
+  while [ $# -gt 0 ]; do
+    case $1 in
+      -h|--help) usage "$script"; exit 0 ;;
+      --deck|--N|--tend|--np|--lmp|--work|--extra|--mpirun-flags)
+        [ $# -ge 2 ] || { echo "$(basename "$script"): $1 needs a value" >&2; exit 2; }
+        case $1 in
+          --deck) deck=$2 ;;
+          --N) N=$2 ;;
+          --tend) tend=$2 ;;
+          --np) np=$2 ;;
+          --lmp) lmp=$2 ;;
+          --work) work=$2 ;;
+          --extra) extra=$2 ;;
+          --mpirun-flags) mpirun_flags=$2 ;;
+        esac
+        shift 2 ;;
+      *) echo "$(basename "$script"): unknown option $1 (--help: the usage)" >&2; exit 2 ;;
+    esac
+  done
+}
+
+# After parse_options: Open MPI allowed to run as root, one OpenMP thread, `cores`, the work
+# directory made and entered with the deck prepared in it (prepare_fibre_deck), `timevar`
+# (time_vars).
+enter_work() {  # src
+  export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 OMP_NUM_THREADS=1
+  cores=$(getconf _NPROCESSORS_ONLN)
+  mkdir -p "$work"
+  cd "$work" || exit 1
+  prepare_fibre_deck "$1" "$deck"
+  timevar=$(time_vars "$deck" "$tend")
+}
 
 # Copies examples/<deck>/ into the current directory (the examples stay untouched) with the
 # thermo columns set to the fix's iterations, contacts and timings (f_fc[8] preconditioner

@@ -10,9 +10,13 @@
 #
 # Usage: bench/e2e_speed.sh [--deck material|silo] [--N 1400] [--tend 3.0] [--np 1]
 #                           [--lmp build/fix/lmp_fibre] [--work DIR] [--extra "KEYS"]
+#                           [--mpirun-flags "F"]
 # tend: simulated seconds (material: -var tend; silo: -var tfill, no discharge).
+# mpirun flags: default --mca btl_vader_single_copy_mechanism none (see mpi_scaling.sh).
+# The options are those of mpi_scaling.sh (bench/common.sh parses both).
 set -euo pipefail
 src=$(cd "$(dirname "$0")/.." && pwd)
+. "$src/bench/common.sh"
 deck=material
 N=1400
 tend=3.0
@@ -20,26 +24,10 @@ np=1
 lmp=$src/build/fix/lmp_fibre
 work=/tmp/fibre_e2e_speed
 extra=""
-while [ $# -gt 0 ]; do
-  case $1 in
-    --deck) deck=$2; shift 2 ;;
-    --N) N=$2; shift 2 ;;
-    --tend) tend=$2; shift 2 ;;
-    --np) np=$2; shift 2 ;;
-    --lmp) lmp=$2; shift 2 ;;
-    --work) work=$2; shift 2 ;;
-    --extra) extra=$2; shift 2 ;;
-    *) echo "unknown option $1" >&2; exit 2 ;;
-  esac
-done
-export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 OMP_NUM_THREADS=1
-cores=$(getconf _NPROCESSORS_ONLN)
-mkdir -p "$work"
-cd "$work"
-. "$src/bench/common.sh"
-prepare_fibre_deck "$src" "$deck"
-timevar=$(time_vars "$deck" "$tend")
-flags="--mca btl_vader_single_copy_mechanism none"
+mpirun_flags="--mca btl_vader_single_copy_mechanism none"
+parse_options "$0" "$@"
+enter_work "$src"
+flags=$mpirun_flags
 [ "$np" -gt "$cores" ] && flags="$flags --oversubscribe"
 
 echo "e2e_speed: $(date -u '+%Y-%m-%d %H:%M UTC'), $(hostname), $cores cores, np $np;" \

@@ -25,7 +25,8 @@
 # cores needs --oversubscribe (added automatically when np > cores).
 set -euo pipefail
 src=$(cd "$(dirname "$0")/.." && pwd)
-nps="1 2"
+. "$src/bench/common.sh"
+np="1 2"  # a list here
 deck=material
 N=1400
 tend=2.0
@@ -33,26 +34,9 @@ lmp=$src/build/fix/lmp_fibre
 work=/tmp/fibre_mpi_scaling
 extra=""
 mpirun_flags="--mca btl_vader_single_copy_mechanism none"
-while [ $# -gt 0 ]; do
-  case $1 in
-    --np) nps=$2; shift 2 ;;
-    --deck) deck=$2; shift 2 ;;
-    --N) N=$2; shift 2 ;;
-    --tend) tend=$2; shift 2 ;;
-    --lmp) lmp=$2; shift 2 ;;
-    --work) work=$2; shift 2 ;;
-    --extra) extra=$2; shift 2 ;;
-    --mpirun-flags) mpirun_flags=$2; shift 2 ;;
-    *) echo "unknown option $1" >&2; exit 2 ;;
-  esac
-done
-export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 OMP_NUM_THREADS=1
-cores=$(getconf _NPROCESSORS_ONLN)
-mkdir -p "$work"
-cd "$work"
-. "$src/bench/common.sh"
-prepare_fibre_deck "$src" "$deck"
-timevar=$(time_vars "$deck" "$tend")
+parse_options "$0" "$@"
+nps=$np
+enter_work "$src"
 
 echo "mpi_scaling: $(date -u '+%Y-%m-%d %H:%M UTC'), $(hostname), $cores cores;" \
      "deck $deck N $N tend $tend, extra '$extra', mpirun flags '$mpirun_flags'"

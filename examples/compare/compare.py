@@ -55,15 +55,14 @@ import numpy as np
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 REPO = os.path.dirname(os.path.dirname(HERE))
+sys.path.insert(0, os.path.join(REPO, "tools"))
+import lammps_runs  # noqa: E402  (tools/lammps_runs.py: shared with tests/e2e/fibre_e2e.py)
+from lammps_runs import SCENE_FILES  # noqa: E402
 DEFAULT_WORK = "/tmp/scenes/compare"
 DEFAULT_OUT = os.path.join(HERE, "results")
 METHODS = ("native", "fibre")
 COLORS = {"native": "tab:blue", "fibre": "tab:red"}
 LABELS = {"native": "native (Hertz-Mindlin, nve/sphere)", "fibre": "fix fibre_contact"}
-SCENE_FILES = {
-    "silo": ["in.silo", "in.silo.native", "scene.silo", "run.silo"],
-    "material": ["in.material", "in.material.native", "scene.material", "run.material"],
-}
 RHO = 1.0          # sphere density of both scenes
 G = 9.81
 
@@ -78,29 +77,8 @@ def parse_thermo(path):
     """Thermo blocks of a LAMMPS log: list (one per run) of dicts column -> numpy array."""
     if not os.path.exists(path):
         die("no log file %s (run it first: compare.py run ...)" % path)
-    blocks, header, rows = [], None, []
-    with open(path, errors="replace") as f:
-        for line in f:
-            words = line.split()
-            if words and words[0] == "Step":
-                header, rows = words, []
-                continue
-            if header is None:
-                continue
-            if line.startswith("Loop time") or line.startswith("ERROR"):
-                blocks.append((header, rows))
-                header = None
-                continue
-            if len(words) != len(header):
-                continue
-            try:
-                rows.append([float(w) for w in words])
-            except ValueError:
-                continue
-    if header is not None and rows:
-        blocks.append((header, rows))
     out = []
-    for header, rows in blocks:
+    for header, rows in lammps_runs.thermo_blocks(lammps_runs.read_text(path)):
         if rows:
             a = np.array(rows)
             out.append({h: a[:, k] for k, h in enumerate(header)})
@@ -111,37 +89,15 @@ def parse_thermo(path):
 
 def log_value(path, prefix):
     """Words of the last log line that starts with prefix (or None)."""
-    found = None
-    with open(path, errors="replace") as f:
-        for line in f:
-            if line.startswith(prefix):
-                found = line.split()
-    return found
+    return lammps_runs.last_line_words(lammps_runs.read_text(path), prefix)
 
 
 def read_frames(path):
     """All frames of a LAMMPS custom dump: list of (step, dict column -> array)."""
     frames = []
-    with open(path) as f:
-        lines = f.read().splitlines()
-    i = 0
-    step, count = 0, 0
-    while i < len(lines):
-        line = lines[i]
-        if line.startswith("ITEM: TIMESTEP"):
-            step = int(lines[i + 1])
-            i += 2
-        elif line.startswith("ITEM: NUMBER OF ATOMS"):
-            count = int(lines[i + 1])
-            i += 2
-        elif line.startswith("ITEM: ATOMS"):
-            cols = line.split()[2:]
-            a = np.array([[float(w) for w in lines[i + 1 + k].split()] for k in range(count)])
-            a = a.reshape(count, len(cols))
-            frames.append((step, {c: a[:, k] for k, c in enumerate(cols)}))
-            i += 1 + count
-        else:
-            i += 1
+    for step, cols, rows in lammps_runs.parse_dump(path):
+        a = np.array(rows, dtype=float).reshape(len(rows), len(cols))
+        frames.append((step, {c: a[:, k] for k, c in enumerate(cols)}))
     return frames
 
 
@@ -172,18 +128,15 @@ def run_dir(work, scene, n, tag=None):
 def run_one(a, scene, method, n, tag=None, variables=()):
     d = run_dir(a.workdir, scene, n, tag)
     os.makedirs(d, exist_ok=True)
-    for f in SCENE_FILES[scene]:
-        shutil.copy(os.path.join(REPO, "examples", scene, f), d)
+    lammps_runs.copy_scene(REPO, scene, d)
     deck = "in." + scene + (".native" if method == "native" else "")
     exe = a.lmp if method == "native" else a.lmp_fibre
-    cmd = []
-    if a.np > 1:
-        cmd = [a.mpirun, "--allow-run-as-root", "--oversubscribe", "-np", str(a.np)]
+    cmd = lammps_runs.mpi_prefix(a.mpirun, a.np)
     cmd += ["nice", "-n", "5", exe, "-in", deck, "-log", log_name(scene, method, n, tag),
             "-screen", "none", "-var", "N", str(n)]
     for k, v in variables:
         cmd += ["-var", k, str(v)]
-    env = dict(os.environ, OMP_NUM_THREADS="1", OMPI_MCA_mpi_yield_when_idle="1")
+    env = lammps_runs.lmp_env()
     print("[%s] %s" % (d, " ".join(cmd)), flush=True)
     t0 = time.time()
     rc = subprocess.call(cmd, cwd=d, env=env)

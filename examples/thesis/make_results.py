@@ -13,11 +13,11 @@ Raw outputs (full histories, eigenvalues, stdout) go to examples/thesis/work/ (n
 
 Experiments (caps chosen so that the whole thing runs in about an hour on 2 loaded cores;
 the weights and combine experiments on N = 350 and 700, Sigma scaling on N = 700):
-- main: both forms x uzawa, cr, minres x none, jacobi, block, fibre, tree, z weight, up to
+- main: both forms x cg (the thesis's Uzawa), cr, minres x none, jacobi, block, fibre, tree, z weight, up to
   N iterations (N = the form's size), capped (CONTACT_CAP / BODY_CAP below) where N is large;
   spectra dense up to 3000 unknowns, Lanczos (LANCZOS_STEPS_MAIN steps at most) above.
-- weights: fibre and tree with the z, straight and impulse edge weights (uzawa, cr).
-- sigma: Sigma x 1e-4 .. 1e2 on the 700 systems (none, block, fibre, tree; uzawa, cr).
+- weights: fibre and tree with the z, straight and impulse edge weights (cg, cr).
+- sigma: Sigma x 1e-4 .. 1e2 on the 700 systems (none, block, fibre, tree; cg, cr).
 - combine: multipreconditioning (fibre_analyze --combine) against tree alone.
 Needs numpy and matplotlib (Debian python3-numpy, python3-matplotlib).
 """
@@ -37,6 +37,9 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
+import analyze_output  # noqa: E402  (this folder: the readers shared with plot_convergence.py)
+from analyze_output import METHOD_STYLES as STYLES, METHODS, method_name  # noqa: E402
+
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(os.path.dirname(HERE))
 SYSDIR = os.path.join(HERE, "systems")
@@ -47,7 +50,6 @@ FIG = os.path.join(HERE, "fig")
 SCENES = ["silo", "material"]
 SIZES = [350, 700, 1400, 2600, 5000]
 PRECONDS = ["none", "jacobi", "block", "fibre", "tree"]
-METHODS = ["uzawa", "cr", "minres"]
 COMBOS = ["add_fibre_tree", "mul_tree_fibre", "add_fibre_zs", "add_tree_zs"]
 WEIGHTS = ["z", "straight", "impulse"]
 SIGMA_SCALES = ["1e-4", "1e-2", "1", "1e2"]
@@ -66,26 +68,24 @@ TARGET = 1e-6
 # The thesis's Table 1 (fibre preconditioner, contact form: r_r and v_e at 100 iterations)
 # and Table 2 (kappa_e without / with the fibre preconditioner; None = "X").
 THESIS_BODIES = {"silo": [346, 668, 1377, 2567, 4988], "material": [313, 631, 1271, 2514, 5035]}
-THESIS_T1 = {  # (scene, index) -> {method: (r_r, v_e)}
-    ("silo", 0): {"uzawa": (-10, -5), "cr": (-12, -5), "minres": (-11, -5)},
-    ("silo", 1): {"uzawa": (-8, -3), "cr": (-10, -3), "minres": (-8, -3)},
-    ("silo", 2): {"uzawa": (-8, -2), "cr": (-10, -3), "minres": (-8, -3)},
-    ("silo", 3): {"uzawa": (-6, 0), "cr": (-8, 0), "minres": (-6, 0)},
-    ("silo", 4): {"uzawa": (-7, -2), "cr": (-9, -2), "minres": (-8, -2)},
-    ("material", 0): {"uzawa": (-10, -5), "cr": (-11, -5), "minres": (-10, -5)},
-    ("material", 1): {"uzawa": (-8, -3), "cr": (-9, -3), "minres": (-8, -3)},
-    ("material", 2): {"uzawa": (-8, -3), "cr": (-9, -3), "minres": (-8, -3)},
-    ("material", 3): {"uzawa": (-6, -1), "cr": (-8, -1), "minres": (-7, -1)},
-    ("material", 4): {"uzawa": (-6, -1), "cr": (-8, -1), "minres": (-7, -1)},
+THESIS_T1 = {  # (scene, index) -> {method: (r_r, v_e)}; the thesis's Uzawa is cg
+    ("silo", 0): {"cg": (-10, -5), "cr": (-12, -5), "minres": (-11, -5)},
+    ("silo", 1): {"cg": (-8, -3), "cr": (-10, -3), "minres": (-8, -3)},
+    ("silo", 2): {"cg": (-8, -2), "cr": (-10, -3), "minres": (-8, -3)},
+    ("silo", 3): {"cg": (-6, 0), "cr": (-8, 0), "minres": (-6, 0)},
+    ("silo", 4): {"cg": (-7, -2), "cr": (-9, -2), "minres": (-8, -2)},
+    ("material", 0): {"cg": (-10, -5), "cr": (-11, -5), "minres": (-10, -5)},
+    ("material", 1): {"cg": (-8, -3), "cr": (-9, -3), "minres": (-8, -3)},
+    ("material", 2): {"cg": (-8, -3), "cr": (-9, -3), "minres": (-8, -3)},
+    ("material", 3): {"cg": (-6, -1), "cr": (-8, -1), "minres": (-7, -1)},
+    ("material", 4): {"cg": (-6, -1), "cr": (-8, -1), "minres": (-7, -1)},
 }
 THESIS_T2 = {"silo": [(72906, 159), (123656, 466), (141024, 580), (228939, 5236), (None, None)],
              "material": [(630634, 302), (746710, 1000), (910868, 499), (790574, 994),
                           (None, None)]}
 
-COLOURS = {"none": "black", "jacobi": "tab:orange", "block": "tab:blue", "fibre": "tab:green",
-           "tree": "tab:red", "add_fibre_tree": "tab:purple", "mul_tree_fibre": "tab:brown",
-           "add_fibre_zs": "tab:olive", "add_tree_zs": "tab:pink"}
-STYLES = {"uzawa": "-", "cr": "--", "minres": ":"}
+COLOURS = {**analyze_output.PRECOND_COLOURS, "add_fibre_tree": "tab:purple",
+           "mul_tree_fibre": "tab:brown", "add_fibre_zs": "tab:olive", "add_tree_zs": "tab:pink"}
 
 
 # ---------------------------------------------------------------- running fibre_analyze
@@ -159,19 +159,19 @@ def jobs_for(name, info):
     if size in SIDE_SIZES:
         for wt in WEIGHTS:
             tag = f"{name}_weight_{wt}"
-            jobs.append((tag, [sysf, "--form", "both", "--methods", "uzawa,cr", "--precond",
+            jobs.append((tag, [sysf, "--form", "both", "--methods", "cg,cr", "--precond",
                                "fibre,tree", "--weight", wt, "--maxiter", str(SIDE_MAXITER),
                                "--csv", w(tag + ".csv"), "--spectra", w(tag),
                                "--kappa", "lanczos", "--lanczos-steps", str(LANCZOS_STEPS)]))
         tag = f"{name}_combine"
-        jobs.append((tag, [sysf, "--form", "both", "--methods", "uzawa,cr", "--precond", "tree",
+        jobs.append((tag, [sysf, "--form", "both", "--methods", "cg,cr", "--precond", "tree",
                            "--combine", ",".join(COMBOS), "--maxiter", str(SIDE_MAXITER),
                            "--csv", w(tag + ".csv"), "--spectra", w(tag),
                            "--kappa", "lanczos", "--lanczos-steps", str(LANCZOS_STEPS)]))
     if size in SIGMA_SIZES:
         for s in SIGMA_SCALES:
             tag = f"{name}_sigma_{s}"
-            jobs.append((tag, [sysf, "--form", "both", "--methods", "uzawa,cr", "--precond",
+            jobs.append((tag, [sysf, "--form", "both", "--methods", "cg,cr", "--precond",
                                "none,block,fibre,tree", "--sigma-scale", s, "--maxiter",
                                str(SIDE_MAXITER), "--csv", w(tag + ".csv"), "--spectra", w(tag),
                                "--kappa", "lanczos", "--lanczos-steps", str(LANCZOS_STEPS)]))
@@ -181,17 +181,10 @@ def jobs_for(name, info):
 # ---------------------------------------------------------------- reading the outputs
 
 def read_history(path):
-    runs = {}
-    with open(path) as f:
-        lines = [ln for ln in f if ln.strip() and not ln.startswith("#")]
-    for row in csv.DictReader(lines):
-        key = (row["form"], row["method"], row["precond"])
-        r = runs.setdefault(key, ([], [], [], []))
-        r[0].append(int(row["iteration"]))
-        r[1].append(float(row["rr"]))
-        r[2].append(float(row["ve"]))
-        r[3].append(float(row["ve_rel"]))
-    return {k: tuple(np.asarray(c) for c in v) for k, v in runs.items()}
+    """{(form, method, precond): (iteration, rr, ve, ve_rel) arrays} (`uzawa` read as `cg`)."""
+    runs, _ = analyze_output.read_history(path, ("iteration", "rr", "ve", "ve_rel"))
+    return {k: (np.asarray(c["iteration"], dtype=int), np.asarray(c["rr"]), np.asarray(c["ve"]),
+                np.asarray(c["ve_rel"])) for k, c in runs.items()}
 
 
 def read_seconds(path):
@@ -204,9 +197,9 @@ def read_seconds(path):
                 form = m.group(1)
                 continue
             w = line.split()
-            if form and len(w) == 11 and w[1] in METHODS:
+            if form and len(w) == 11 and method_name(w[1]) in METHODS:
                 try:
-                    out[(form, w[0], w[1])] = (int(w[2]), float(w[10]))
+                    out[(form, w[0], method_name(w[1]))] = (int(w[2]), float(w[10]))
                 except ValueError:
                     pass
     return out
@@ -244,17 +237,8 @@ def read_eigs(prefix, form, precond):
     path = f"{prefix}_{form}_{precond}.csv"
     if not os.path.exists(path):
         return None, None
-    head, vals = {}, []
-    with open(path) as f:
-        for line in f:
-            if line.startswith("# method"):
-                head["method"] = line[9:].strip()
-            elif line.startswith("# kappa_e"):
-                w = line[2:].split()
-                head.update({a: float(b) for a, b in zip(w[0::2], w[1::2])})
-            elif not line.startswith("#") and line.strip():
-                vals.append(float(line))
-    return np.asarray(vals), head
+    head = analyze_output.read_spectrum(path)
+    return np.asarray(head.pop("eigenvalues")), head
 
 
 def summary(hist):
@@ -520,7 +504,7 @@ def overview_figures(rows, kap, side):
     plt.close(fig)
     # iterations to ve_rel 1e-6 and ve_rel at 100 against N
     fig, axes = plt.subplots(1, 2, figsize=(11, 4))
-    for ax, form, meth in ((axes[0], "contact", "cr"), (axes[1], "body", "uzawa")):
+    for ax, form, meth in ((axes[0], "contact", "cr"), (axes[1], "body", "cg")):
         for p in PRECONDS:
             for scene, mk in (("silo", "o-"), ("material", "s--")):
                 pts = sorted((r["bodies"], r["verel100"]) for r in rows
@@ -540,7 +524,7 @@ def overview_figures(rows, kap, side):
     srows = side["sigma"]
     if srows:
         fig, axes = plt.subplots(1, 2, figsize=(11, 4))
-        for ax, form, meth in ((axes[0], "contact", "cr"), (axes[1], "body", "uzawa")):
+        for ax, form, meth in ((axes[0], "contact", "cr"), (axes[1], "body", "cg")):
             for p in ["none", "block", "fibre", "tree"]:
                 for name, mk in (("silo700", "o-"), ("material700", "s--")):
                     pts = sorted((float(r["variant"]), r["verel100"]) for r in srows
@@ -624,7 +608,7 @@ def write_results_md(present, missing, rows, kap, heads, side, timings):
     add("|---|---|---|---|---|---|---|---|---|")
     for scene in SCENES:
         for size in SIZES:
-            for form, ms in (("contact", ["cr"]), ("body", ["uzawa", "cr"])):
+            for form, ms in (("contact", ["cr"]), ("body", ["cg", "cr"])):
                 for m in ms:
                     rs = [idx.get((scene, size, form, m, p)) for p in PRECONDS]
                     if not any(rs):
@@ -639,12 +623,12 @@ def write_results_md(present, missing, rows, kap, heads, side, timings):
     # cost per iteration
     L = []
     add = L.append
-    add("| scene | bodies | form | ms/iteration uzawa: none | jacobi | block | fibre | tree |")
+    add("| scene | bodies | form | ms/iteration cg: none | jacobi | block | fibre | tree |")
     add("|---|---|---|---|---|---|---|---|")
     for scene in SCENES:
         for size in SIZES:
             for form in ("contact", "body"):
-                rs = [idx.get((scene, size, form, "uzawa", p)) for p in PRECONDS]
+                rs = [idx.get((scene, size, form, "cg", p)) for p in PRECONDS]
                 if not any(rs):
                     continue
                 b = next(r for r in rs if r)["bodies"]
@@ -684,7 +668,7 @@ def write_results_md(present, missing, rows, kap, heads, side, timings):
     wi = {(r["name"], r["variant"], r["form"], r["method"], r["precond"]): r
           for r in side["weights"]}
     for name in present:
-        for form, m in (("contact", "cr"), ("body", "uzawa")):
+        for form, m in (("contact", "cr"), ("body", "cg")):
             for p in ("fibre", "tree"):
                 cells = []
                 for w in WEIGHTS:
@@ -708,7 +692,7 @@ def write_results_md(present, missing, rows, kap, heads, side, timings):
     for r in side["sigma"]:
         sig_rel[(r["name"], r["variant"])] = r["sigma_rel"]
     for name in present:
-        for form, m in (("contact", "cr"), ("body", "uzawa")):
+        for form, m in (("contact", "cr"), ("body", "cg")):
             for p in ("none", "block", "fibre", "tree"):
                 cells = []
                 for s in SIGMA_SCALES:
@@ -729,7 +713,7 @@ def write_results_md(present, missing, rows, kap, heads, side, timings):
         "ms/iteration | ms to 1e-6 |")
     add("|---|---|---|---|---|---|---|---|---|")
     for r in side["combine"]:
-        if (r["form"], r["method"]) not in (("contact", "cr"), ("body", "uzawa")):
+        if (r["form"], r["method"]) not in (("contact", "cr"), ("body", "cg")):
             continue
         ms = r["ms_per_iter"]
         tot = f"{ms * r['to1e6']:.1f}" if ms and r["to1e6"] else "-"

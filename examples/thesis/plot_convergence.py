@@ -19,7 +19,6 @@ Typical use, on the LAMMPS-poured pile that test_fibre_analyze leaves in the bui
 Needs numpy and matplotlib (Debian python3-numpy, python3-matplotlib); draws with Agg.
 """
 import argparse
-import csv
 import glob
 import math
 import os
@@ -31,32 +30,16 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402  (after the backend is chosen)
 import numpy as np  # noqa: E402
 
-PRECOND_COLOURS = {"none": "black", "jacobi": "tab:orange", "block": "tab:blue",
-                   "fibre": "tab:green", "tree": "tab:red"}
-METHOD_STYLES = {"uzawa": "-", "cr": "--", "minres": "-."}
+import analyze_output  # noqa: E402  (this folder: the readers shared with make_results.py)
+from analyze_output import METHOD_STYLES, PRECOND_COLOURS, method_name  # noqa: E402
+
 REPORT_ITERATION = 100  # the thesis's dotted line and its Table 1
 
 
 def read_history(path):
-    """Runs {(form, method, precond): columns} and sizes {form: N} from the history CSV."""
-    runs, sizes = {}, {}
-    with open(path, newline="") as f:
-        lines = []
-        for line in f:
-            if line.startswith("# size "):
-                words = line.split()
-                sizes[words[2]] = int(words[3])
-            elif line.strip() and not line.startswith("#"):
-                lines.append(line)
-    reader = csv.DictReader(lines)
-    wanted = ["form", "method", "precond", "iteration", "rr", "rb", "ve", "ve_rel"]
-    if reader.fieldnames is None or any(c not in reader.fieldnames for c in wanted):
-        raise ValueError(f"{path}: not a fibre_analyze history (columns {', '.join(wanted)})")
-    for row in reader:
-        run = runs.setdefault((row["form"], row["method"], row["precond"]),
-                              {c: [] for c in wanted[3:]})
-        for c in wanted[3:]:
-            run[c].append(float(row[c]))
+    """Runs {(form, method, precond): columns} and sizes {form: N} from the history CSV
+    (method `uzawa` of older files read as `cg`)."""
+    runs, sizes = analyze_output.read_history(path)
     return ({k: {c: np.asarray(v) for c, v in cols.items()} for k, cols in runs.items()},
             sizes)
 
@@ -97,26 +80,10 @@ def plot_convergence(runs, sizes, form, measure, ylabel, title, path, methods, p
 
 def read_spectrum(path):
     """Eigenvalues and header facts of one spectrum file written by fibre_analyze --spectra."""
-    info = {"path": path}
-    values = []
-    with open(path) as f:
-        for line in f:
-            if line.startswith("# fibre_analyze spectrum:"):
-                # "# fibre_analyze spectrum: form contact, precond block (P^-1 A), n 6180"
-                words = line.replace(",", " ").split()
-                info["form"] = words[words.index("form") + 1]
-                info["precond"] = words[words.index("precond") + 1]
-            elif line.startswith("# method "):
-                info["method"] = line[len("# method "):].strip()
-            elif line.startswith("# kappa_e "):
-                words = line[2:].split()
-                for name, value in zip(words[0::2], words[1::2]):
-                    info[name] = float(value)
-            elif line.strip() and not line.startswith("#"):
-                values.append(float(line))
+    info = analyze_output.read_spectrum(path)
     if "form" not in info or "lambda_r" not in info:
         raise ValueError(f"{path}: not a fibre_analyze spectrum file")
-    info["eigenvalues"] = np.asarray(values)
+    info["eigenvalues"] = np.asarray(info["eigenvalues"])
     return info
 
 
@@ -154,8 +121,8 @@ def plot_spectra(spectra, form, title, path, preconds):
     return path
 
 
-def split_list(text, allowed):
-    items = [t for t in text.split(",") if t]
+def split_list(text, allowed, name=str):
+    items = [name(t) for t in text.split(",") if t]
     bad = [t for t in items if t not in allowed]
     if bad or not items:
         raise argparse.ArgumentTypeError(
@@ -171,8 +138,9 @@ def main(argv=None):
     ap.add_argument("--out", default=".", help="directory for the PNG files (default .)")
     ap.add_argument("--name", help="file name stem (default: the CSV's)")
     ap.add_argument("--title", default="", help="text that starts every title")
-    ap.add_argument("--methods", default="uzawa,cr,minres",
-                    type=lambda t: split_list(t, list(METHOD_STYLES)))
+    ap.add_argument("--methods", default="cg,cr,minres",
+                    type=lambda t: split_list(t, list(METHOD_STYLES), method_name),
+                    help="Krylov methods to draw (default cg,cr,minres; uzawa: cg)")
     ap.add_argument("--precond", default="none,jacobi,block,fibre,tree",
                     type=lambda t: split_list(t, list(PRECOND_COLOURS)))
     ap.add_argument("--absolute-ve", action="store_true",

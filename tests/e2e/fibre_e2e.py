@@ -5,8 +5,9 @@ Every test is a script run by ctest as
     python3 test_x.py --lmp PATH_TO_lmp_fibre --mpirun PATH --workdir DIR --source REPO_ROOT
 
 It writes its input decks into the work directory, runs lmp_fibre on them, parses the log,
-thermo and dump output and checks numbers. `Checks` collects the results, prints one line per
-check and a closing "N passed, M failed" line, and gives the exit status.
+thermo and dump output (tools/lammps_runs.py, shared with examples/compare/compare.py) and
+checks numbers. `Checks` collects the results, prints one line per check and a closing
+"N passed, M failed" line, and gives the exit status.
 
 Python 3 standard library only.
 """
@@ -17,6 +18,12 @@ import os
 import subprocess
 import sys
 import time
+
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "tools"))
+# the tests call e2e.parse_thermo, e2e.parse_dump, e2e.dump_by_id, e2e.last_line_words and
+# e2e.copy_scene: one code with examples/compare/compare.py
+from lammps_runs import (copy_scene, dump_by_id, last_line_words, lmp_env,  # noqa: E402,F401
+                         mpi_prefix, parse_dump, parse_thermo, read_text)
 
 
 def parse_args():
@@ -65,18 +72,11 @@ def run_lmp(args, deck, name, np=1, variables=None, timeout=600):
     log_path = os.path.join(args.workdir, "log." + name)
     with open(deck_path, "w") as f:
         f.write(deck)
-    cmd = []
-    if np > 1:
-        cmd = [args.mpirun, "--allow-run-as-root", "--oversubscribe", "-np", str(np)]
+    cmd = mpi_prefix(args.mpirun, np)
     cmd += [args.lmp, "-in", deck_path, "-log", log_path, "-echo", "none"]
     for key, value in (variables or {}).items():
         cmd += ["-var", key, str(value)]
-    env = dict(os.environ)
-    env.setdefault("OMPI_ALLOW_RUN_AS_ROOT", "1")
-    env.setdefault("OMPI_ALLOW_RUN_AS_ROOT_CONFIRM", "1")
-    env.setdefault("OMPI_MCA_rmaps_base_oversubscribe", "1")
-    env.setdefault("OMP_NUM_THREADS", "1")
-    env.setdefault("OMPI_MCA_mpi_yield_when_idle", "1")  # more ranks than cores
+    env = lmp_env()
     if os.path.exists(log_path):
         os.remove(log_path)
     t0 = time.time()
@@ -87,73 +87,9 @@ def run_lmp(args, deck, name, np=1, variables=None, timeout=600):
     except subprocess.TimeoutExpired as e:
         rc, out = -9, (e.stdout or b"").decode("utf-8", "replace") + "\nTIMEOUT"
     seconds = time.time() - t0
-    log_text = ""
-    if os.path.exists(log_path):
-        with open(log_path, errors="replace") as f:
-            log_text = f.read()
+    log_text = read_text(log_path) if os.path.exists(log_path) else ""
     # errors of other ranks than 0 reach only the screen: keep both for messages
     return Run(name, rc, out + "\n" + log_text, log_text, seconds)
-
-
-def parse_thermo(text):
-    """Thermo blocks of a LAMMPS log: a list (one per run) of lists of {column: value}."""
-    blocks, header, rows = [], None, None
-    for line in text.splitlines():
-        words = line.split()
-        if words and words[0] == "Step":
-            header, rows = words, []
-            continue
-        if header is None:
-            continue
-        if line.startswith("Loop time") or line.startswith("ERROR"):
-            blocks.append(rows)
-            header = None
-            continue
-        if len(words) != len(header):
-            continue  # warnings between thermo lines
-        try:
-            values = [float(w) for w in words]
-        except ValueError:
-            continue
-        rows.append(dict(zip(header, values)))
-    if header is not None and rows:
-        blocks.append(rows)
-    return blocks
-
-
-def parse_dump(path):
-    """A LAMMPS text dump (atom or local): list of (timestep, columns, rows)."""
-    frames = []
-    with open(path) as f:
-        lines = f.read().splitlines()
-    i = 0
-    while i < len(lines):
-        if lines[i].startswith("ITEM: TIMESTEP"):
-            step = int(lines[i + 1])
-            i += 2
-            continue
-        if lines[i].startswith("ITEM: NUMBER OF"):
-            count = int(lines[i + 1])
-            i += 2
-            continue
-        if lines[i].startswith("ITEM: ATOMS") or lines[i].startswith("ITEM: ENTRIES"):
-            columns = lines[i].split()[2:]
-            rows = [[float(w) for w in lines[i + 1 + k].split()] for k in range(count)]
-            frames.append((step, columns, rows))
-            i += 1 + count
-            continue
-        i += 1
-    return frames
-
-
-def dump_by_id(frame):
-    """{atom id: {column: value}} of one dump frame with an 'id' column."""
-    step, columns, rows = frame
-    out = {}
-    for r in rows:
-        d = dict(zip(columns, r))
-        out[int(d["id"])] = d
-    return out
 
 
 class Checks:
@@ -174,6 +110,10 @@ class Checks:
         else:
             self.failed += 1
         return ok
+
+    def agree(self, a, b, tol, what, fmt="%.6g"):
+        """a and b agree within the relative tolerance tol (rel_err)."""
+        return self.check(rel_err(a, b) < tol, what, (fmt + " vs " + fmt) % (a, b))
 
     def ran(self, run, what=None):
         """The run finished with status 0."""

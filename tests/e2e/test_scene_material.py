@@ -12,17 +12,10 @@ machine): both complete, insert the first batch, and agree on the kinetic energy
 """
 
 import os
-import shutil
 
 import fibre_e2e as e2e
 
 N, TEND, PER_BATCH, BATCHES = 350, 2.5, 81, 3
-
-
-def copy_scene(args):
-    src = os.path.join(args.source, "examples", "material")
-    for f in ("in.material", "in.material.native", "scene.material", "run.material"):
-        shutil.copy(os.path.join(src, f), args.workdir)
 
 
 def deck(args, name):
@@ -40,7 +33,7 @@ def mean_height(args, method):
 def main():
     args = e2e.parse_args()
     ck = e2e.Checks("scene: material, N %d, %.1f s" % (N, TEND))
-    copy_scene(args)
+    e2e.copy_scene(args.source, "material", args.workdir)
     heights = {}
     for tag, np_, name in (("serial", 1, "in.material"), ("native", 1, "in.material.native")):
         run = e2e.run_lmp(args, deck(args, name), "material_" + tag, np=np_,
@@ -48,9 +41,9 @@ def main():
         if not ck.ran(run, "%s: material deck completes" % tag):
             continue
         rows = run.thermo[-1]
-        ins = [l for l in run.log.splitlines() if l.startswith("Particle insertion:")]
-        ck.check(bool(ins) and ins[-1].split()[2] == str(PER_BATCH),
-                 "%s: emitter batches of %d" % (tag, PER_BATCH), ins[-1] if ins else "no line")
+        ins = e2e.last_line_words(run.log, "Particle insertion:")
+        ck.check(bool(ins) and ins[2] == str(PER_BATCH),
+                 "%s: emitter batches of %d" % (tag, PER_BATCH), " ".join(ins or ["no line"]))
         atoms = rows[-1]["Atoms"]
         ck.check(atoms == PER_BATCH * BATCHES, "%s: %d spheres inserted, none lost"
                  % (tag, PER_BATCH * BATCHES), "%g atoms" % atoms)
@@ -83,13 +76,11 @@ def main():
                      "%g atoms" % last["Atoms"])
             ke[tag] = last["c_ke"]
     if len(ke) == 2:
-        ck.check(e2e.rel_err(ke["short_serial"], ke["short_np2"]) < 0.05,
-                 "serial and np 2 agree on the kinetic energy",
-                 "%.6g vs %.6g" % (ke["short_serial"], ke["short_np2"]))
+        ck.agree(ke["short_serial"], ke["short_np2"], 0.05,
+                 "serial and np 2 agree on the kinetic energy")
     if "serial" in heights and "native" in heights:
-        ck.check(e2e.rel_err(heights["serial"], heights["native"]) < 0.10,
-                 "fibre_contact and native agree on the mean height",
-                 "%.4g vs %.4g" % (heights["serial"], heights["native"]))
+        ck.agree(heights["serial"], heights["native"], 0.10,
+                 "fibre_contact and native agree on the mean height", "%.4g")
     ck.close()
 
 

@@ -91,9 +91,8 @@ def main():
                 ke[(name, tag)] = last["KinEng"] if "KinEng" in last else last["c_1"]
     for name in ("funnel", "pour"):
         if (name, "serial") in ke and (name, "np2") in ke:
-            a, b = ke[(name, "serial")], ke[(name, "np2")]
-            ck.check(e2e.rel_err(a, b) < 0.05, "%s: serial and np 2 agree on the kinetic energy"
-                     % name, "%.6g vs %.6g" % (a, b))
+            ck.agree(ke[(name, "serial")], ke[(name, "np2")], 0.05,
+                     "%s: serial and np 2 agree on the kinetic energy" % name)
     ck.close()
 
 
