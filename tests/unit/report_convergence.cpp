@@ -19,6 +19,7 @@
 #include <cstdio>
 #include <string>
 
+#include "fibre/spook.hpp"
 #include "fibre/direct.hpp"
 #include "fibre/krylov.hpp"
 #include "fibre/preconditioner_family.hpp"

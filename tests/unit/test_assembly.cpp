@@ -1,6 +1,7 @@
 // Explicit assembly against the independent dense references of reference.hpp.
 #include <gtest/gtest.h>
 
+#include "fibre/spook.hpp"
 #include "fibre/assembly.hpp"
 #include "fibre/kernels.hpp"
 #include "fibre/scenes.hpp"

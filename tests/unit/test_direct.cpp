@@ -14,6 +14,7 @@
 #include <random>
 #include <string>
 
+#include "fibre/spook.hpp"
 #include "fibre/direct.hpp"
 #include "fibre/scenes.hpp"
 #include "fibre/spectra.hpp"

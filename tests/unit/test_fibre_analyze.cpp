@@ -23,6 +23,7 @@
 #include <string>
 #include <vector>
 
+#include "fibre/spook.hpp"
 #include "fibre/assembly.hpp"
 #include "fibre/krylov.hpp"
 #include "fibre/preconditioner_family.hpp"

@@ -1,6 +1,7 @@
 // The matrix-free Schur product and blocks against the dense thesis formula.
 #include <gtest/gtest.h>
 
+#include "fibre/spook.hpp"
 #include "fibre/kernels.hpp"
 #include "fibre/operators.hpp"
 #include "fibre/scenes.hpp"

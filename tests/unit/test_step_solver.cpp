@@ -5,6 +5,7 @@
 #include <cmath>
 #include <limits>
 
+#include "fibre/spook.hpp"
 #include "fibre/step_solver.hpp"
 #include "fibre/kernels.hpp"
 #include "fibre/scenes.hpp"
@@ -49,7 +50,7 @@ Body sphere(double mass, double radius, const Vec3 &x)
 // measured ones of the fix): MINRES, block preconditioner, tol 1e-6, 5 passes.
 StepOptions base_options()
 {
-  StepOptions o = base_options();
+  StepOptions o;
   o.solver = Method::minres;
   o.precond.kind = PrecondKind::block;
   o.stop.tol = 1e-6;

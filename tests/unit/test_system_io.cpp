@@ -8,6 +8,7 @@
 #include <limits>
 #include <sstream>
 
+#include "fibre/spook.hpp"
 #include "fibre/scenes.hpp"
 #include "fibre/system_io.hpp"
 #include "reference.hpp"

@@ -52,7 +52,7 @@ ContactGraph contact_graph(const ContactSystem &sys, bool include_ghosts);
 // bodies[body_start[f] .. body_start[f+1]) in chain order and the contacts
 // contacts[contact_start[f] .. contact_start[f+1]), contact k joining bodies k and k+1 of the
 // fibre. Every fibre has at least two bodies. The position in these arrays is the fibre
-// numbering (see Relabelling).
+// numbering.
 //
 // The greedy (deterministic; ties of the weight go to the smaller contact index): bodies are
 // tried as start bodies in index order. An unmarked start body with an unmarked neighbour

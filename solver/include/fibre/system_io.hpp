@@ -1,6 +1,6 @@
 // Whole contact systems as text files, and Matrix Market export for SciPy/MATLAB users.
 //
-// Format "fibre_contact_system", version 1 (also in docs/system_format.md). Line oriented,
+// Format "fibre_contact_system", version 1 (also in doc/system_format.md). Line oriented,
 // tokens separated by blanks; blank lines and lines starting with '#' are ignored anywhere.
 // Reals are written like printf's %.17g (locale independent), which reads back bit for bit.
 //

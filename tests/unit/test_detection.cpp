@@ -1,0 +1,138 @@
+// Contact detection without LAMMPS: the contact criterion, plane walls, region cutoffs and
+// the one order of a step's contacts, against hand-computed cases.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <random>
+
+#include "fibre/detection.hpp"
+
+using namespace fibre;
+
+namespace {
+
+Body sphere(double r, const Vec3 &x, const Vec3 &v = Vec3::Zero(), const Vec3 &f = Vec3::Zero())
+{
+  Body b;
+  b.mass = 2.0;
+  b.radius = r;
+  b.x = x;
+  b.v = v;
+  b.force = f;
+  return b;
+}
+
+}  // namespace
+
+// Within 1% of the smaller radius a pair is a contact whatever its motion.
+TEST(Detection, MarginMakesRestingNeighboursContacts)
+{
+  const Body a = sphere(0.5, Vec3(0, 0, 1)), b = sphere(0.25, Vec3(0, 0, 0));
+  const Vec3 n = Vec3::UnitZ();
+  EXPECT_TRUE(is_contact(a, &b, n, 0.0024, 1e-3, 2.0));   // below 0.01 * 0.25
+  EXPECT_FALSE(is_contact(a, &b, n, 0.0026, 1e-3, 2.0));  // above, at rest
+  EXPECT_TRUE(is_contact(a, &b, n, -0.1, 1e-3, 2.0));     // overlapping
+}
+
+// Beyond the margin a pair is a contact when it closes within (damping + 1) steps at its
+// free-flight approach speed: v_rel + h (f_a / m_a - f_b / m_b) along -n.
+TEST(Detection, ApproachWithinDampingPlusOneSteps)
+{
+  const double h = 0.01, d = 2.0, r = 0.5;
+  const Vec3 n = Vec3::UnitZ();  // from b to a
+  const Body b = sphere(r, Vec3::Zero());
+  // approach 1 m/s: reach (d + 1) h * 1 = 0.03 beyond the margin 0.005
+  const Body a = sphere(r, Vec3(0, 0, 1.1), Vec3(0, 0, -1.0));
+  EXPECT_TRUE(is_contact(a, &b, n, 0.005 + 0.0299, h, d));
+  EXPECT_FALSE(is_contact(a, &b, n, 0.005 + 0.0301, h, d));
+  // separating: never, however close beyond the margin
+  const Body away = sphere(r, Vec3(0, 0, 1.1), Vec3(0, 0, 1.0));
+  EXPECT_FALSE(is_contact(away, &b, n, 0.006, h, d));
+  // gravity over the step counts: at rest, f/m = -100 m/s^2 gives 1 m/s in one step
+  const Body falling = sphere(r, Vec3(0, 0, 1.1), Vec3::Zero(), Vec3(0, 0, -200.0));
+  EXPECT_TRUE(is_contact(falling, &b, n, 0.005 + 0.0299, h, d));
+  // a wall (b == nullptr) counts only a's motion
+  EXPECT_TRUE(is_contact(a, nullptr, n, 0.005 + 0.0299, h, d));
+}
+
+TEST(Detection, PlaneWallsBothSidesWithinReach)
+{
+  WallSpec w;
+  w.kind = WallKind::yplane;
+  w.has_lo = w.has_hi = true;
+  w.lo = -1.0;
+  w.hi = 2.0;
+  PlaneHit hits[2];
+  // centre 0.3 above lo, radius 0.25: gap 0.05 < reach 0.1; hi is 1.7 away
+  ASSERT_EQ(plane_hits(w, sphere(0.25, Vec3(5, -0.7, 3)), 0.1, hits), 1);
+  EXPECT_EQ(hits[0].sub, 0);
+  EXPECT_EQ(hits[0].normal, Vec3::UnitY());
+  EXPECT_DOUBLE_EQ(hits[0].distance, 0.3);
+  // a big sphere touches both
+  ASSERT_EQ(plane_hits(w, sphere(1.6, Vec3(0, 0.5, 0)), 0.1, hits), 2);
+  EXPECT_EQ(hits[1].sub, 1);
+  EXPECT_EQ(hits[1].normal, -Vec3::UnitY());
+  EXPECT_DOUBLE_EQ(hits[1].distance, 1.5);
+  // a one-sided wall ignores the other side
+  w.has_hi = false;
+  EXPECT_EQ(plane_hits(w, sphere(1.6, Vec3(0, 0.5, 0)), 0.1, hits), 1);
+  EXPECT_EQ(plane_hits(w, sphere(0.25, Vec3(0, 0.5, 0)), 0.1, hits), 0);
+}
+
+TEST(Detection, RegionCutoffCappedByTheSkin)
+{
+  const double h = 0.01, d = 2.0;
+  EXPECT_DOUBLE_EQ(region_cutoff(sphere(0.5, Vec3::Zero()), h, d, 0.1), 0.505);
+  // 2 m/s over 3 steps: 0.06 < skin
+  EXPECT_DOUBLE_EQ(region_cutoff(sphere(0.5, Vec3::Zero(), Vec3(0, 2, 0)), h, d, 0.1),
+                   0.505 + 0.06);
+  EXPECT_DOUBLE_EQ(region_cutoff(sphere(0.5, Vec3::Zero(), Vec3(0, 20, 0)), h, d, 0.1),
+                   0.505 + 0.1);
+}
+
+TEST(Detection, WallKeysAreNegativeAndDistinct)
+{
+  EXPECT_DOUBLE_EQ(wall_key(0, 0), -1.0);
+  EXPECT_DOUBLE_EQ(wall_key(0, 1), -2.0);
+  EXPECT_DOUBLE_EQ(wall_key(2, 5), -(2.0 * kWallKeyStride + 6.0));
+  EXPECT_NE(wall_key(1, 0), wall_key(0, kWallKeyStride - 1));
+}
+
+// The order depends on the contacts only, not on the order they were found in.
+TEST(Detection, SortIsIndependentOfInputOrder)
+{
+  std::vector<DetectedContact> found;
+  for (long long a : {3, 1, 2})
+    for (double partner : {-2.0, 7.0, 5.0}) {
+      DetectedContact c;
+      c.tag_a = a;
+      c.partner = partner;
+      c.contact.gap = 0.1 * a + partner;
+      found.push_back(c);
+    }
+  std::vector<DetectedContact> shuffled = found;
+  std::shuffle(shuffled.begin(), shuffled.end(), std::mt19937(7));
+  sort_contacts(found);
+  sort_contacts(shuffled);
+  for (std::size_t k = 0; k < found.size(); ++k) {
+    EXPECT_EQ(found[k].tag_a, shuffled[k].tag_a);
+    EXPECT_EQ(found[k].partner, shuffled[k].partner);
+    if (k > 0) {
+      EXPECT_LE(found[k - 1].tag_a, found[k].tag_a);
+      if (found[k - 1].tag_a == found[k].tag_a) {
+        EXPECT_LT(found[k - 1].partner, found[k].partner);
+      }
+    }
+  }
+  EXPECT_EQ(found.front().tag_a, 1);
+  EXPECT_EQ(found.front().partner, -2.0);
+}
+
+TEST(Detection, WallNames)
+{
+  WallKind k;
+  EXPECT_TRUE(parse("region", k));
+  EXPECT_EQ(k, WallKind::region);
+  EXPECT_FALSE(parse("cylinder", k));
+  EXPECT_EQ(choices<WallKind>(), "xplane|yplane|zplane|region");
+}

@@ -1,0 +1,115 @@
+// Projected Gauss-Seidel as a solver of its own: its fixed point solves the nonsmooth step
+// (the same impulses as the settled MUMPS answer), and every stop has its typed reason.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+
+#include "fibre/pgs.hpp"
+#include "fibre/scenes.hpp"
+#include "fibre/spook.hpp"
+#include "fibre/step_solver.hpp"
+#include "reference.hpp"
+
+using namespace fibre;
+using fibre::test::rel_diff;
+
+namespace {
+
+struct Problem {
+  ContactSystem sys;
+  FrictionParams friction;
+  Vector b;
+};
+
+Problem pile(int n, double mu)
+{
+  SceneParams p;
+  p.seed = 11;
+  Problem pr{pile_scene(n, p), FrictionParams{}, Vector()};
+  pr.friction.mu = mu;
+  pr.b = spook_rhs(pr.sys);
+  return pr;
+}
+
+}  // namespace
+
+TEST(Pgs, ConvergesToTheSettledDirectAnswer)
+{
+  Problem pr = pile(60, 0.4);
+  StepOptions ref_opt;
+  ref_opt.solver = Method::direct;
+  ref_opt.form = Form::contact;
+  ref_opt.active_set_max = 60;
+  ref_opt.friction = pr.friction;
+  const StepResult ref = solve_step(pr.sys, serial_exchange(), ref_opt, nullptr, MPI_COMM_SELF);
+  ASSERT_TRUE(ref.set_settled);
+
+  const Cones cones(pr.sys, pr.friction);
+  const std::vector<Vec6> scale = row_scales(pr.sys);
+  Vector lambda = Vector::Zero(pr.sys.contact_dofs());
+  const PgsResult res =
+      pgs(pr.sys, serial_exchange(), cones, pr.b, scale, lambda, PgsControl{100000, 1e-12, 100000});
+  EXPECT_EQ(res.reason, StopReason::converged);
+  EXPECT_LT(res.last_change, 1e-12);
+  EXPECT_LT(complementarity(pr.sys, serial_exchange(), cones, pr.b, lambda, scale), 1e-9);
+  EXPECT_LT(rel_diff(lambda, ref.lambda), 1e-6);
+  // the reference's caps settle to cap_tol 1e-6 of the largest impulse
+  EXPECT_LT(rel_diff(velocity_change(pr.sys, serial_exchange(), lambda), ref.dv), 1e-5);
+}
+
+TEST(Pgs, TypedStopReasons)
+{
+  Problem pr = pile(60, 0.4);
+  const Cones cones(pr.sys, pr.friction);
+  const std::vector<Vec6> scale = row_scales(pr.sys);
+  Vector lambda = Vector::Zero(pr.sys.contact_dofs());
+  PgsResult res =
+      pgs(pr.sys, serial_exchange(), cones, pr.b, scale, lambda, PgsControl{3, 1e-12, 100});
+  EXPECT_EQ(res.reason, StopReason::max_iterations);
+  EXPECT_EQ(res.sweeps, 3);
+  // a stall window of one sweep: the first sweep that does not beat the best stops it
+  lambda.setZero();
+  res = pgs(pr.sys, serial_exchange(), cones, pr.b, scale, lambda, PgsControl{100000, 0.0, 1});
+  EXPECT_EQ(res.reason, StopReason::stagnation);
+  EXPECT_LT(res.sweeps, 100000);
+  // non-finite rows of b project to zero: the impulses stay finite
+  Vector bad = pr.b;
+  bad[0] = std::numeric_limits<double>::quiet_NaN();
+  bad[7] = std::numeric_limits<double>::infinity();
+  lambda.setZero();
+  res = pgs(pr.sys, serial_exchange(), cones, bad, scale, lambda, PgsControl{});
+  EXPECT_NE(res.reason, StopReason::non_finite);
+  EXPECT_TRUE(lambda.allFinite());
+  // a non-finite start poisons the velocities: the first sweep is undone and says so
+  lambda.setZero();
+  lambda[3] = std::numeric_limits<double>::quiet_NaN();
+  res = pgs(pr.sys, serial_exchange(), cones, pr.b, scale, lambda, PgsControl{});
+  EXPECT_EQ(res.reason, StopReason::non_finite);
+  EXPECT_EQ(res.sweeps, 1);
+  EXPECT_TRUE(std::isnan(lambda[3]));
+  EXPECT_EQ(lambda.norm() != lambda.norm(), true);  // unchanged: the caller's start
+}
+
+// solver pgs in the step: no linear pass, and the sweeps' accuracy in the result.
+TEST(Pgs, AsTheStepSolver)
+{
+  Problem pr = pile(60, 0.4);
+  StepOptions o;
+  o.solver = Method::pgs;
+  o.friction = pr.friction;
+  o.sweeps = 100000;
+  o.sweep_tol = 1e-10;
+  const StepResult res = solve_step(pr.sys, serial_exchange(), o, nullptr, MPI_COMM_SELF);
+  EXPECT_EQ(res.total_iterations, 0);
+  EXPECT_EQ(res.active_set_passes, 0);
+  EXPECT_TRUE(res.converged);
+  EXPECT_EQ(res.sweep_reason, StopReason::converged);
+  EXPECT_LT(res.complementarity, 1e-7);
+  o.sweeps = 2;
+  const StepResult cut = solve_step(pr.sys, serial_exchange(), o, nullptr, MPI_COMM_SELF);
+  EXPECT_FALSE(cut.converged);
+  EXPECT_EQ(cut.reason, StopReason::max_iterations);
+  EXPECT_EQ(cut.sweeps, 2);
+  EXPECT_TRUE(cut.lambda.allFinite());
+}

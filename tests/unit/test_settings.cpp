@@ -1,0 +1,127 @@
+// The fix's keywords without LAMMPS: no keyword leaves every default of StepOptions{} and
+// ContactModel{} (the one home of the defaults), each keyword sets what it names, and bad
+// input names the keyword and its expected form.
+#include <gtest/gtest.h>
+
+#include <sstream>
+
+#include "fibre/settings.hpp"
+
+using namespace fibre;
+
+namespace {
+
+std::vector<std::string> words(const std::string &text)
+{
+  std::istringstream in(text);
+  std::vector<std::string> out;
+  for (std::string w; in >> w;) out.push_back(w);
+  return out;
+}
+
+std::string error_of(const std::string &text)
+{
+  try {
+    parse_settings(words(text));
+  } catch (SettingsError &e) {
+    return e.what();
+  }
+  return "";
+}
+
+}  // namespace
+
+TEST(Settings, NoKeywordsKeepTheDefaults)
+{
+  const Settings s = parse_settings({});
+  const StepOptions d{};
+  EXPECT_EQ(describe(s.step), describe(d));
+  // the measured defaults (doc/design.md section 4)
+  EXPECT_EQ(d.form, Form::body);
+  EXPECT_EQ(d.solver, Method::cg);
+  EXPECT_EQ(d.precond.kind, PrecondKind::tree);
+  EXPECT_EQ(d.precond.weight, EdgeWeight::z);
+  EXPECT_DOUBLE_EQ(d.stop.tol, 1e-4);
+  EXPECT_EQ(d.stop.max_iter, 200);
+  EXPECT_DOUBLE_EQ(d.pass_tol, 1e-3);
+  EXPECT_EQ(d.active_set_max, 1);
+  EXPECT_EQ(d.sweeps, 50);
+  EXPECT_DOUBLE_EQ(d.sweep_tol, 1e-3);
+  EXPECT_DOUBLE_EQ(d.friction.mu, 0.5);
+  EXPECT_EQ(s.model.rows, 6);
+  EXPECT_DOUBLE_EQ(s.model.damping, 2.0);
+  EXPECT_TRUE(s.model.compliance.automatic);
+  EXPECT_DOUBLE_EQ(s.model.compliance.factor, 1e-2);
+  EXPECT_TRUE(s.walls.empty());
+  EXPECT_EQ(s.export_every, 0);
+  EXPECT_EQ(describe(s),
+            "form body, solver cg, precond tree, weight z, tol 0.0001, pass_tol 0.001, maxiter "
+            "200, mu 0.5, mu_roll 0, mu_twist 0, active_set 1, sweeps 50, sweep_tol 0.001, rows "
+            "6, damping 2, compliance auto (0.01 dt^2 / m_min)");
+}
+
+TEST(Settings, EveryKeywordSetsWhatItNames)
+{
+  const Settings s = parse_settings(
+      words("form contact solver uzawa precond fibre weight impulse tol 1e-6 pass_tol 1e-5 "
+            "maxiter 77 compliance 1e-7 2e-7 damping 3 mu 0.3 mu_roll 0.1 mu_twist 0.05 rows 6 "
+            "active_set 4 sweeps 9 sweep_tol 1e-4 wall zplane 0 NULL wall xplane -1 1 "
+            "wall region box export 10 out/sys"));
+  EXPECT_EQ(s.step.form, Form::contact);
+  EXPECT_EQ(s.step.solver, Method::cg);  // uzawa is an alias
+  EXPECT_EQ(s.step.precond.kind, PrecondKind::fibre);
+  EXPECT_EQ(s.step.precond.weight, EdgeWeight::impulse);
+  EXPECT_DOUBLE_EQ(s.step.stop.tol, 1e-6);
+  EXPECT_DOUBLE_EQ(s.step.pass_tol, 1e-5);
+  EXPECT_EQ(s.step.stop.max_iter, 77);
+  EXPECT_FALSE(s.model.compliance.automatic);
+  EXPECT_DOUBLE_EQ(s.model.compliance.eps_n, 1e-7);
+  EXPECT_DOUBLE_EQ(s.model.compliance.eps_t, 2e-7);
+  EXPECT_DOUBLE_EQ(s.model.damping, 3.0);
+  EXPECT_DOUBLE_EQ(s.step.friction.mu, 0.3);
+  EXPECT_DOUBLE_EQ(s.step.friction.mu_roll, 0.1);
+  EXPECT_DOUBLE_EQ(s.step.friction.mu_twist, 0.05);
+  EXPECT_EQ(s.step.active_set_max, 4);
+  EXPECT_EQ(s.step.sweeps, 9);
+  EXPECT_DOUBLE_EQ(s.step.sweep_tol, 1e-4);
+  ASSERT_EQ(s.walls.size(), 3u);
+  EXPECT_EQ(s.walls[0].kind, WallKind::zplane);
+  EXPECT_TRUE(s.walls[0].has_lo);
+  EXPECT_FALSE(s.walls[0].has_hi);
+  EXPECT_EQ(s.walls[1].axis(), 0);
+  EXPECT_DOUBLE_EQ(s.walls[1].lo, -1.0);
+  EXPECT_DOUBLE_EQ(s.walls[1].hi, 1.0);
+  EXPECT_EQ(s.walls[2].region_id, "box");
+  EXPECT_EQ(s.export_every, 10);
+  EXPECT_EQ(s.export_prefix, "out/sys");
+  EXPECT_NE(describe(s).find("compliance 1e-07 2e-07"), std::string::npos);
+  EXPECT_EQ(parse_settings(words("solver pgs")).step.solver, Method::pgs);
+  EXPECT_EQ(parse_settings(words("solver mumps")).step.solver, Method::direct);
+}
+
+TEST(Settings, BadInputNamesTheKeywordAndItsForm)
+{
+  EXPECT_EQ(error_of("form primal"), "expected 'form body|contact', got 'primal'");
+  EXPECT_EQ(error_of("solver bicgstab"),
+            "expected 'solver cg|cr|minres|direct|pgs', got 'bicgstab'");
+  EXPECT_EQ(error_of("precond"), "expected 'precond none|jacobi|block|fibre|tree'");
+  EXPECT_EQ(error_of("tol -1"), "expected 'tol <positive number>', got '-1'");
+  EXPECT_EQ(error_of("tol 1e-3x"), "expected 'tol <positive number>', got '1e-3x'");
+  EXPECT_EQ(error_of("tol nan"), "expected 'tol <positive number>', got 'nan'");
+  EXPECT_EQ(error_of("maxiter 2.5"), "expected 'maxiter <positive integer>', got '2.5'");
+  EXPECT_EQ(error_of("sweeps -1"), "expected 'sweeps <non-negative integer>', got '-1'");
+  EXPECT_EQ(error_of("mu -0.1"), "expected 'mu <non-negative number>', got '-0.1'");
+  EXPECT_EQ(error_of("rows 4"), "expected 'rows 3|6', got '4'");
+  EXPECT_EQ(error_of("compliance 1e-6"),
+            "expected 'compliance auto' or 'compliance <eps_n> <eps_t>' (positive numbers)");
+  EXPECT_EQ(error_of("wall zplane NULL NULL"),
+            "expected 'wall zplane <lo|NULL> <hi|NULL>' with at least one of lo and hi a number");
+  EXPECT_EQ(error_of("wall zplane 2 1"),
+            "expected 'wall zplane <lo|NULL> <hi|NULL>' with lo < hi, got '2 1'");
+  EXPECT_EQ(error_of("wall region"), "expected 'wall region <region-ID>'");
+  EXPECT_EQ(error_of("export 10"), "expected 'export <N> <file-prefix>' (N a positive integer)");
+  EXPECT_EQ(error_of("rows 3 mu_roll 0.1"),
+            "mu_roll and mu_twist need 'rows 6' (rows 3 has no rotational rows)");
+  EXPECT_NE(error_of("speed 3").find("expected a keyword (form, solver"), std::string::npos);
+  EXPECT_NE(error_of("speed 3").find("got 'speed'"), std::string::npos);
+}
