@@ -5,7 +5,7 @@ set -euo pipefail
 
 packages=(
   # build tools
-  cmake g++ make pkg-config clang libclang-rt-14-dev
+  cmake g++ make pkg-config clang libclang-rt-14-dev clang-format
   # LAMMPS with headers, cmake config and official example decks
   lammps liblammps-dev lammps-examples
   # MPI, linear algebra, direct solver

@@ -3,7 +3,8 @@
 #   1. ctest on the normal build: unit tests, report binaries, end-to-end lmp_fibre runs
 #      (serial and mpirun -np 2/4);
 #   2. the unit tests again on an ASan+UBSan build;
-#   3. the system-file reader's libFuzzer target, briefly.
+#   3. the system-file reader's libFuzzer target, briefly;
+# after checking that the C++ sources follow .clang-format.
 # Exits non-zero on any failure.
 set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
@@ -11,6 +12,12 @@ cd "$root"
 jobs="$(nproc)"
 
 bash cmake/install-deps.sh
+
+echo "== format (clang-format --dry-run with .clang-format) =="
+mapfile -t sources < <(find fix solver tools tests bench -name '*.cpp' -o -name '*.hpp' -o \
+  -name '*.h' | sort)
+clang-format --style=file --dry-run --Werror "${sources[@]}"
+echo "format: ${#sources[@]} files follow .clang-format"
 
 echo "== normal build =="
 cmake -S . -B build -DCMAKE_BUILD_TYPE=RelWithDebInfo -DFIBRE_BUILD_FIX=ON -DFIBRE_BUILD_TESTS=ON \

@@ -45,7 +45,8 @@ run 2
 CASES = [
     ("form_invalid", "form primal", "expected 'form body|contact', got 'primal'", {}),
     ("form_missing", "form", "expected 'form body|contact'", {}),
-    ("solver_invalid", "solver bicgstab", "expected 'solver uzawa|cr|minres|direct', got "
+    # the choices are Method's name table: cg (uzawa an accepted alias), cr, minres, direct, pgs
+    ("solver_invalid", "solver bicgstab", "expected 'solver cg|cr|minres|direct|pgs', got "
      "'bicgstab'", {}),
     ("precond_invalid", "precond ilu", "expected 'precond none|jacobi|block|fibre|tree', got "
      "'ilu'", {}),

@@ -29,7 +29,7 @@ SparseMatrix assemble_A(const ContactSystem &sys);
 // rows and columns hold this process's contact terms alone (partial sums for the owner).
 SparseMatrix assemble_K(const ContactSystem &sys);
 
-// b = -(4/h) Upsilon g - (1 - Upsilon) G v - h G M^-1 f_ext with the assembled G (design.md
+// b = -(4/h) Upsilon g - (1 - Upsilon) G v - h G M^-1 f_ext with the assembled G (doc/design.md
 // section 2); g enters on active normal rows only.
 Vector assemble_rhs(const ContactSystem &sys);
 

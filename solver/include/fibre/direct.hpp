@@ -1,4 +1,4 @@
-// The direct solver (design.md section 4): MUMPS on an assembled sparse SPD matrix,
+// The direct solver (doc/design.md section 4): MUMPS on an assembled sparse SPD matrix,
 // distributed over the ranks of an MPI communicator. It is the reference solution of the
 // Krylov methods and a `solver` choice of its own.
 //

@@ -1,4 +1,4 @@
-// The communicator interface of the solver library (design.md section 6).
+// The communicator interface of the solver library (doc/design.md section 6).
 //
 // The library never calls MPI itself for halo data: the front end (the LAMMPS fix) implements
 // forward/reverse exchange of per-body vectors, and global sums. Serial runs and unit tests

@@ -1,4 +1,4 @@
-// The two forms of the regularized contact system (thesis 2.2, design.md section 7) as
+// The two forms of the regularized contact system (thesis 2.2, doc/design.md section 7) as
 // linear operators that the Krylov methods and preconditioners see.
 #pragma once
 

@@ -1,5 +1,5 @@
 // Preconditioners: one small interface, setup from the system, apply to a vector.
-// All are symmetric positive definite, in either form (design.md section 3).
+// All are symmetric positive definite, in either form (doc/design.md section 3).
 #pragma once
 
 #include <memory>

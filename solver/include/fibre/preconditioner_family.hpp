@@ -1,4 +1,4 @@
-// The preconditioner family of design.md section 3 in both forms, and its factory.
+// The preconditioner family of doc/design.md section 3 in both forms, and its factory.
 #pragma once
 
 #include <memory>

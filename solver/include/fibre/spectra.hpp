@@ -1,5 +1,5 @@
 // Spectra of the preconditioned operators and the effective condition number kappa_e
-// (design.md section 4, thesis section 5).
+// (doc/design.md section 4, thesis section 5).
 //
 // kappa_e = lambda_1 / lambda_r over the eigenvalues of P^-1 A sorted descending,
 // lambda_1 >= lambda_2 >= ... >= lambda_n > 0. The "largest gap" is the largest ratio

@@ -84,7 +84,7 @@ struct StepResult {
 // (converged = false). With Method::pgs there is no linear pass: `converged` then says whether
 // the sweeps met sweep_tol.
 //
-// The active-set loop (design.md section 2): each pass solves the rows of the current set
+// The active-set loop (doc/design.md section 2): each pass solves the rows of the current set
 // with the capped cones' impulses in the rhs; contacts with lambda_n < 0 are released, cones
 // that leave their radius are capped along the solved direction. Rows outside the solve are
 // judged by their trial impulse (lambda + rho / sigma with rho the row's residual): released

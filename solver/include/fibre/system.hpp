@@ -1,4 +1,4 @@
-// Bodies, contacts and the SPOOK contact system (design.md section 2, thesis 2.1-2.2).
+// Bodies, contacts and the SPOOK contact system (doc/design.md section 2, thesis 2.1-2.2).
 //
 // Plain data: a ContactSystem owns its bodies and contacts and the derived per-contact
 // kinematics, Sigma and right-hand side. Nothing here knows about MPI or LAMMPS; bodies
@@ -63,7 +63,7 @@ struct ContactKinematics {
   Vec3 rb;     // p - x_b (unused for walls)
 };
 
-// SPOOK parameters (design.md section 2).
+// SPOOK parameters (doc/design.md section 2).
 struct SpookParams {
   double h = 1e-3;       // time step
   double damping = 2.0;  // d = tau / h, in steps (thesis uses tau = 2h)
