@@ -1,6 +1,7 @@
 // Synthetic contact systems for tests, benchmarks and reports: the thesis's 3x3 grid and
-// polydisperse piles made by ballistic deposition. Real scenes come from the LAMMPS decks
-// in examples/ through `fix fibre_contact export`.
+// polydisperse piles made by ballistic deposition. Test support (library fibre_scenes), not
+// part of fibre_solver. Real scenes come from the LAMMPS decks in examples/ through
+// `fix fibre_contact export`.
 #pragma once
 
 #include <cstdint>
