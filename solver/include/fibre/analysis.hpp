@@ -142,7 +142,8 @@ struct FormSetup {
   std::vector<PrecondEntry> preconds;
 };
 
-// `impulses`: normal impulse per contact for EdgeWeight::impulse (nullptr: z weights).
+// `impulses`: normal impulse per contact for EdgeWeight::impulse (nullptr: z weights). The
+// operator (and the combinations) refer to `sys`: it must outlive the setup.
 FormSetup setup_form(Form form, const ContactSystem &sys, const AnalysisOptions &opt,
                      const Vector *impulses);
 
@@ -206,7 +207,8 @@ struct AnalysisProgress {
   std::function<void(const SpectrumRun &)> spectrum;
 };
 
-// Nothing is computed for a system without contacts.
+// Nothing is computed for a system without contacts. The forms' operators refer to `sys`: it
+// must outlive the result.
 Analysis analyze(const ContactSystem &sys, const AnalysisOptions &opt,
                  const AnalysisProgress &progress = {});
 
