@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "fibre/scenes.hpp"
+#include "fibre/spook.hpp"
 
 namespace fibre::bench {
 
