@@ -23,15 +23,6 @@ using namespace fibre;
 
 namespace {
 
-const ContactSystem &scene(int contacts)
-{
-  static std::map<int, std::unique_ptr<ContactSystem>> cache;
-  auto &slot = cache[contacts];
-  if (!slot)
-    slot = std::make_unique<ContactSystem>(bench::heap_scene(bench::heap_bodies_for(contacts)));
-  return *slot;
-}
-
 void counters(benchmark::State &state, const ContactSystem &sys)
 {
   const double n = sys.num_contacts();
@@ -43,7 +34,7 @@ void counters(benchmark::State &state, const ContactSystem &sys)
 
 template <Form F, PrecondKind K> void BM_Build(benchmark::State &state)
 {
-  const ContactSystem &sys = scene(static_cast<int>(state.range(0)));
+  const ContactSystem &sys = bench::cached_heap_scene(static_cast<int>(state.range(0)));
   PrecondOptions opt;
   opt.kind = K;
   for (auto _ : state) {
@@ -55,7 +46,7 @@ template <Form F, PrecondKind K> void BM_Build(benchmark::State &state)
 
 template <Form F, PrecondKind K> void BM_Apply(benchmark::State &state)
 {
-  const ContactSystem &sys = scene(static_cast<int>(state.range(0)));
+  const ContactSystem &sys = bench::cached_heap_scene(static_cast<int>(state.range(0)));
   PrecondOptions opt;
   opt.kind = K;
   const auto P = make_preconditioner(F, sys, serial_exchange(), opt);
@@ -70,7 +61,7 @@ template <Form F, PrecondKind K> void BM_Apply(benchmark::State &state)
 
 template <bool IsForest> void BM_Graph(benchmark::State &state)
 {
-  const ContactSystem &sys = scene(static_cast<int>(state.range(0)));
+  const ContactSystem &sys = bench::cached_heap_scene(static_cast<int>(state.range(0)));
   for (auto _ : state) {
     if (IsForest) {
       Forest t = build_forest(sys, EdgeWeight::z, nullptr, true);
@@ -85,7 +76,7 @@ template <bool IsForest> void BM_Graph(benchmark::State &state)
 
 template <Form F> void BM_Product(benchmark::State &state)
 {
-  const ContactSystem &sys = scene(static_cast<int>(state.range(0)));
+  const ContactSystem &sys = bench::cached_heap_scene(static_cast<int>(state.range(0)));
   const auto op = make_operator(F, sys, serial_exchange());
   const Vector x = Vector::Ones(op->size());
   Vector y;
@@ -110,7 +101,7 @@ class TableReporter : public benchmark::ConsoleReporter {
     double seconds;
     double contacts;
   };
-  std::map<std::string, std::map<int, Entry>> runs;  // name without the argument -> size
+  std::map<std::string, std::map<int, Entry>> runs; // name without the argument -> size
   void ReportRuns(const std::vector<Run> &reports) override
   {
     for (const Run &r : reports) {
@@ -118,27 +109,39 @@ class TableReporter : public benchmark::ConsoleReporter {
       const int arg = std::stoi(r.run_name.args);
       const auto c = r.counters.find("contacts");
       // CPU time (the machine is shared: wall time includes waits for the core).
-      runs[name][arg] = {r.GetAdjustedCPUTime() / 1e3,  // ms -> s
+      runs[name][arg] = {r.GetAdjustedCPUTime() / 1e3, // ms -> s
                          c == r.counters.end() ? 0.0 : double(c->second)};
     }
     ConsoleReporter::ReportRuns(reports);
   }
 };
 
-}  // namespace
+} // namespace
 
 BENCHMARK_TEMPLATE(BM_Graph, false)->Name("fibres")->Apply(sizes);
 BENCHMARK_TEMPLATE(BM_Graph, true)->Name("forest")->Apply(sizes);
-BENCHMARK_TEMPLATE(BM_Build, Form::contact, PrecondKind::block)->Name("contact_block")->Apply(sizes);
-BENCHMARK_TEMPLATE(BM_Build, Form::contact, PrecondKind::fibre)->Name("contact_fibre")->Apply(sizes);
+BENCHMARK_TEMPLATE(BM_Build, Form::contact, PrecondKind::block)
+    ->Name("contact_block")
+    ->Apply(sizes);
+BENCHMARK_TEMPLATE(BM_Build, Form::contact, PrecondKind::fibre)
+    ->Name("contact_fibre")
+    ->Apply(sizes);
 BENCHMARK_TEMPLATE(BM_Build, Form::contact, PrecondKind::tree)->Name("contact_tree")->Apply(sizes);
 BENCHMARK_TEMPLATE(BM_Build, Form::body, PrecondKind::block)->Name("body_block")->Apply(sizes);
 BENCHMARK_TEMPLATE(BM_Build, Form::body, PrecondKind::fibre)->Name("body_fibre")->Apply(sizes);
 BENCHMARK_TEMPLATE(BM_Build, Form::body, PrecondKind::tree)->Name("body_tree")->Apply(sizes);
-BENCHMARK_TEMPLATE(BM_Apply, Form::contact, PrecondKind::block)->Name("apply_contact_block")->Apply(sizes);
-BENCHMARK_TEMPLATE(BM_Apply, Form::contact, PrecondKind::fibre)->Name("apply_contact_fibre")->Apply(sizes);
-BENCHMARK_TEMPLATE(BM_Apply, Form::contact, PrecondKind::tree)->Name("apply_contact_tree")->Apply(sizes);
-BENCHMARK_TEMPLATE(BM_Apply, Form::body, PrecondKind::fibre)->Name("apply_body_fibre")->Apply(sizes);
+BENCHMARK_TEMPLATE(BM_Apply, Form::contact, PrecondKind::block)
+    ->Name("apply_contact_block")
+    ->Apply(sizes);
+BENCHMARK_TEMPLATE(BM_Apply, Form::contact, PrecondKind::fibre)
+    ->Name("apply_contact_fibre")
+    ->Apply(sizes);
+BENCHMARK_TEMPLATE(BM_Apply, Form::contact, PrecondKind::tree)
+    ->Name("apply_contact_tree")
+    ->Apply(sizes);
+BENCHMARK_TEMPLATE(BM_Apply, Form::body, PrecondKind::fibre)
+    ->Name("apply_body_fibre")
+    ->Apply(sizes);
 BENCHMARK_TEMPLATE(BM_Apply, Form::body, PrecondKind::tree)->Name("apply_body_tree")->Apply(sizes);
 BENCHMARK_TEMPLATE(BM_Product, Form::contact)->Name("product_A")->Apply(sizes);
 BENCHMARK_TEMPLATE(BM_Product, Form::body)->Name("product_K")->Apply(sizes);
@@ -150,8 +153,7 @@ int main(int argc, char **argv)
   benchmark::RunSpecifiedBenchmarks(&rep);
   std::printf("\nPreconditioner build and apply, %u hardware threads (serial code), heap_scene:\n",
               std::thread::hardware_concurrency());
-  std::printf("%-20s %9s %10s %10s %10s\n", "build", "contacts", "ms", "ns/contact",
-              "/ product");
+  std::printf("%-20s %9s %10s %10s %10s\n", "build", "contacts", "ms", "ns/contact", "/ product");
   for (const char *name :
        {"fibres", "forest", "contact_block", "contact_fibre", "contact_tree", "body_block",
         "body_fibre", "body_tree", "apply_contact_block", "apply_contact_fibre",

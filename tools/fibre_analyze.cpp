@@ -112,10 +112,10 @@ std::vector<T> parse_list(const std::string &option, const std::string &value, V
   }
   return out;
 }
-template <class T>
-std::vector<T> parse_list(const std::string &option, const std::string &value)
+template <class T> std::vector<T> parse_list(const std::string &option, const std::string &value)
 {
-  return parse_list<T>(option, value, [](T) { return true; }, choices<T>());
+  return parse_list<T>(
+      option, value, [](T) { return true; }, choices<T>());
 }
 
 int parse_positive_int(const std::string &option, const std::string &value)
@@ -168,9 +168,9 @@ Options parse_args(int argc, char **argv)
       arg.resize(eq);
       have_value = true;
     }
-    const char *const known[] = {"--form",   "--methods", "--precond", "--weight",     "--maxiter",
-                                 "--csv",    "--spectra", "--kappa",   "--sigma-scale",
-                                 "--combine", "--lanczos-steps"};
+    const char *const known[] = {"--form",        "--methods", "--precond",      "--weight",
+                                 "--maxiter",     "--csv",     "--spectra",      "--kappa",
+                                 "--sigma-scale", "--combine", "--lanczos-steps"};
     if (std::find(std::begin(known), std::end(known), arg) == std::end(known))
       throw UsageError("unknown option '" + arg + "'");
     if (!have_value) {
@@ -280,8 +280,7 @@ void describe(const AnalysisSystem &in, const Options &opt)
   if (s.active_rows > 0)
     std::printf("  Sigma in [%.4g, %.4g] (compliance scale %g), mean diag(G M^-1 G^T) = %.4g, "
                 "mean Sigma / that = %.3g\n",
-                s.sigma_min, s.sigma_max, opt.sigma_scale, s.mean_diag,
-                s.mean_sigma / s.mean_diag);
+                s.sigma_min, s.sigma_max, opt.sigma_scale, s.mean_diag, s.mean_sigma / s.mean_diag);
   std::printf("  ||b|| = %.4g\n", s.rhs_norm);
 }
 
@@ -328,9 +327,9 @@ void print_run_header(const FormSetup &fs)
               "@100: at iteration 100, '*' = at the last iteration of a shorter run; "
               "to_1e-6: first iteration with ve_rel <= 1e-6)\n",
               to_string(fs.form), fs.maxiter);
-  std::printf("  %-7s %-6s %6s %-14s %9s %9s %9s %10s %14s %8s %7s\n", "precond", "method",
-              "iters", "stop", "r_r@100", "rb@100", "v_e@100", "ve_rel@100", "best ve_rel(k)",
-              "to_1e-6", "s");
+  std::printf("  %-7s %-6s %6s %-14s %9s %9s %9s %10s %14s %8s %7s\n", "precond", "method", "iters",
+              "stop", "r_r@100", "rb@100", "v_e@100", "ve_rel@100", "best ve_rel(k)", "to_1e-6",
+              "s");
 }
 
 void print_run(const Run &run)
@@ -348,8 +347,8 @@ void print_run(const Run &run)
   std::printf("  %-7s %-6s %6d %-14s %9s %9s %9s %10s %14s %8s %7.2f\n", run.precond.c_str(),
               to_string(run.method), run.result.iterations, to_string(run.result.reason),
               cell(&IterationRow::rr).c_str(), cell(&IterationRow::rb).c_str(),
-              cell(&IterationRow::ve).c_str(), cell(&IterationRow::ve_rel).c_str(),
-              best_s.c_str(), to_target.c_str(), run.seconds);
+              cell(&IterationRow::ve).c_str(), cell(&IterationRow::ve_rel).c_str(), best_s.c_str(),
+              to_target.c_str(), run.seconds);
   std::fflush(stdout);
 }
 
@@ -394,7 +393,7 @@ int analyze(const Options &opt)
   AnalysisProgress progress;
   progress.reference = [&](const Analysis &an) { describe_reference(an, weight); };
   progress.form = [&](const FormSetup &fs) { describe_form(fs, weight); };
-  const FormSetup *table = nullptr;  // the form whose run table is open
+  const FormSetup *table = nullptr; // the form whose run table is open
   progress.run = [&](const FormSetup &fs, const Run &run) {
     if (table != &fs) print_run_header(fs);
     table = &fs;
@@ -431,7 +430,7 @@ struct MpiSession {
   MpiSession &operator=(const MpiSession &) = delete;
 };
 
-}  // namespace
+} // namespace
 
 int main(int argc, char **argv)
 {

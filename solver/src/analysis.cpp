@@ -24,9 +24,9 @@ namespace {
 constexpr Eigen::Index kDenseMaxSize = 3000;
 constexpr Eigen::Index kDenseFallbackSize = 8000;
 constexpr int kAutoLanczosSteps = 500;
-constexpr int kNormLanczosSteps = 60;  // Lanczos steps for the ||A||_2 estimate
+constexpr int kNormLanczosSteps = 60; // Lanczos steps for the ||A||_2 estimate
 
-}  // namespace
+} // namespace
 
 // ---- the system ----
 
@@ -92,8 +92,8 @@ Reference direct_reference(const ContactSystem &sys)
   ref.dv_norm = ref.dv.norm();
   ref.lambda = direct_solve(Form::contact, sys, ex, sys.rhs(), MPI_COMM_SELF);
   const Vector dv_contact = body_from_lambda(sys, ex, ref.lambda);
-  ref.contact_velocity_error = ref.dv_norm > 0 ? (dv_contact - ref.dv).norm() / ref.dv_norm
-                                               : dv_contact.norm();
+  ref.contact_velocity_error =
+      ref.dv_norm > 0 ? (dv_contact - ref.dv).norm() / ref.dv_norm : dv_contact.norm();
   ref.seconds = seconds_since(t0);
   return ref;
 }
@@ -139,25 +139,24 @@ FormSetup setup_form(Form form, const ContactSystem &sys, const AnalysisOptions 
     e.combined = true;
     const auto t0 = Clock::now();
     switch (combo) {
-      case Combination::add_fibre_tree:
-        e.P = std::make_unique<AveragePreconditioner>(
-            build(PrecondKind::fibre, opt.weight, nullptr),
-            build(PrecondKind::tree, opt.weight, nullptr), e.name);
-        break;
-      case Combination::mul_tree_fibre:
-        e.P = std::make_unique<SymmetricProductPreconditioner>(
-            *fs.op, build(PrecondKind::tree, opt.weight, nullptr),
-            build(PrecondKind::fibre, opt.weight, nullptr), e.name);
-        break;
-      case Combination::add_fibre_zs:
-      case Combination::add_tree_zs: {
-        const PrecondKind kind =
-            combo == Combination::add_fibre_zs ? PrecondKind::fibre : PrecondKind::tree;
-        e.P = std::make_unique<AveragePreconditioner>(
-            build(kind, EdgeWeight::z, nullptr), build(kind, EdgeWeight::straight, nullptr),
-            e.name);
-        break;
-      }
+    case Combination::add_fibre_tree:
+      e.P = std::make_unique<AveragePreconditioner>(build(PrecondKind::fibre, opt.weight, nullptr),
+                                                    build(PrecondKind::tree, opt.weight, nullptr),
+                                                    e.name);
+      break;
+    case Combination::mul_tree_fibre:
+      e.P = std::make_unique<SymmetricProductPreconditioner>(
+          *fs.op, build(PrecondKind::tree, opt.weight, nullptr),
+          build(PrecondKind::fibre, opt.weight, nullptr), e.name);
+      break;
+    case Combination::add_fibre_zs:
+    case Combination::add_tree_zs: {
+      const PrecondKind kind =
+          combo == Combination::add_fibre_zs ? PrecondKind::fibre : PrecondKind::tree;
+      e.P = std::make_unique<AveragePreconditioner>(
+          build(kind, EdgeWeight::z, nullptr), build(kind, EdgeWeight::straight, nullptr), e.name);
+      break;
+    }
     }
     e.setup_seconds = seconds_since(t0);
     fs.preconds.push_back(std::move(e));
@@ -167,8 +166,8 @@ FormSetup setup_form(Form form, const ContactSystem &sys, const AnalysisOptions 
 
 // ---- one Krylov run ----
 
-Run run_krylov(const FormSetup &fs, const PrecondEntry &pe, Method method,
-               const ContactSystem &sys, const Reference &ref)
+Run run_krylov(const FormSetup &fs, const PrecondEntry &pe, Method method, const ContactSystem &sys,
+               const Reference &ref)
 {
   const Exchange &ex = serial_exchange();
   Run run;
@@ -193,7 +192,7 @@ Run run_krylov(const FormSetup &fs, const PrecondEntry &pe, Method method,
     return row.ve;
   };
   StopControl stop;
-  stop.tol = 0;  // run the full maxiter iterations: the histories are the point
+  stop.tol = 0; // run the full maxiter iterations: the histories are the point
   stop.max_iter = fs.maxiter;
   Vector x = Vector::Zero(fs.op->size());
   const auto t0 = Clock::now();
@@ -230,8 +229,8 @@ int iterations_to(const Run &run, double target)
 
 // ---- spectra ----
 
-SpectrumRun compute_spectrum(const FormSetup &fs, const PrecondEntry &pe,
-                             const ContactSystem &sys, KappaMethod how, int lanczos_steps)
+SpectrumRun compute_spectrum(const FormSetup &fs, const PrecondEntry &pe, const ContactSystem &sys,
+                             KappaMethod how, int lanczos_steps)
 {
   SpectrumRun run;
   run.form = fs.form;
@@ -241,8 +240,7 @@ SpectrumRun compute_spectrum(const FormSetup &fs, const PrecondEntry &pe,
   const auto t0 = Clock::now();
   const bool automatic = how == KappaMethod::automatic;
   const bool body_space = fs.form == Form::contact && pe.kind == PrecondKind::none &&
-                          !pe.combined && uniform_sigma(sys) &&
-                          sys.body_dofs() <= kDenseMaxSize;
+                          !pe.combined && uniform_sigma(sys) && sys.body_dofs() <= kDenseMaxSize;
   if (how == KappaMethod::dense || (automatic && run.n <= kDenseMaxSize)) {
     run.s = dense_spectrum(*fs.op, *pe.P);
     run.method = "dense";
@@ -281,8 +279,7 @@ Analysis analyze(const ContactSystem &sys, const AnalysisOptions &opt,
   if (!an.zero_rhs) {
     an.reference = direct_reference(sys);
     impulses.resize(sys.num_contacts());
-    for (int c = 0; c < sys.num_contacts(); ++c)
-      impulses[c] = an.reference.lambda[sys.rows() * c];
+    for (int c = 0; c < sys.num_contacts(); ++c) impulses[c] = an.reference.lambda[sys.rows() * c];
   }
   if (progress.reference) progress.reference(an);
   const Vector *impulse_ptr = an.zero_rhs ? nullptr : &impulses;
@@ -317,14 +314,13 @@ void write_history_csv(std::ostream &out, const Analysis &analysis, const std::s
       << "residual r, rb = ||r|| / ||rhs||, ve = ||dv - dv*||, ve_rel = ve / ||dv*||\n";
   out << "# sigma_scale " << sigma_scale << "\n";
   for (const FormSetup &fs : analysis.forms)
-    out << "# size " << to_string(fs.form) << ' ' << fs.op->size() << " norm_fro "
-        << fs.norm_fro << " norm_2 " << fs.norm_2 << '\n';
+    out << "# size " << to_string(fs.form) << ' ' << fs.op->size() << " norm_fro " << fs.norm_fro
+        << " norm_2 " << fs.norm_2 << '\n';
   out << "form,method,precond,iteration,rr,rb,ve,ve_rel\n";
   for (const Run &run : analysis.runs)
     for (const IterationRow &r : run.rows)
       out << to_string(run.form) << ',' << to_string(run.method) << ',' << run.precond << ','
-          << r.iteration << ',' << r.rr << ',' << r.rb << ',' << r.ve << ',' << r.ve_rel
-          << '\n';
+          << r.iteration << ',' << r.rr << ',' << r.rb << ',' << r.ve << ',' << r.ve_rel << '\n';
 }
 
 std::string spectrum_path(const std::string &prefix, const SpectrumRun &run)
@@ -337,8 +333,8 @@ void write_spectrum(std::ostream &out, const SpectrumRun &run)
   out.precision(17);
   out << "# fibre_analyze spectrum: form " << to_string(run.form) << ", precond " << run.precond
       << (run.precond == "none" ? " (A)" : " (P^-1 A)") << ", n " << run.n << "\n";
-  out << "# method " << run.method
-      << (run.complete ? " (all eigenvalues)" : " (Ritz values only)") << "\n";
+  out << "# method " << run.method << (run.complete ? " (all eigenvalues)" : " (Ritz values only)")
+      << "\n";
   out << "# kappa_e " << run.s.kappa_e << " kappa " << run.s.kappa << " lambda_1 "
       << run.s.lambda_max << " lambda_r " << run.s.lambda_r << " above_gap " << run.s.r + 1
       << " gap_ratio " << run.s.gap_ratio << "\n";
@@ -355,4 +351,4 @@ void write_kappa_csv(std::ostream &out, const std::vector<SpectrumRun> &runs)
         << r.s.gap_ratio << ',' << r.method << ',' << (r.complete ? 1 : 0) << '\n';
 }
 
-}  // namespace fibre
+} // namespace fibre

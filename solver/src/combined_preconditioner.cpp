@@ -38,4 +38,4 @@ void SymmetricProductPreconditioner::apply(const Vector &r, Vector &z) const
   z += tmp_;
 }
 
-}  // namespace fibre
+} // namespace fibre

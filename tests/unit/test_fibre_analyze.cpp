@@ -45,7 +45,7 @@ namespace {
 const PrecondKind kPreconds[] = {PrecondKind::none, PrecondKind::jacobi, PrecondKind::block,
                                  PrecondKind::fibre, PrecondKind::tree};
 const Method kMethods[] = {Method::cg, Method::cr, Method::minres};
-constexpr double kTarget = 1e-6;  // the tool's "to_1e-6" column
+constexpr double kTarget = 1e-6; // the tool's "to_1e-6" column
 
 fs::path build_dir()
 {
@@ -59,7 +59,7 @@ fs::path tool_path()
 }
 
 struct ToolResult {
-  int status = -1;  // exit status, -1: did not exit normally
+  int status = -1; // exit status, -1: did not exit normally
   std::string out, err;
 };
 
@@ -132,12 +132,15 @@ struct ScratchDir {
 
 // ---- the analysis' results ----
 
-using Key = std::string;  // "form/precond/method"
+using Key = std::string; // "form/precond/method"
 Key key(Form f, const std::string &precond, Method m)
 {
   return std::string(to_string(f)) + "/" + precond + "/" + to_string(m);
 }
-Key key(Form f, PrecondKind k, Method m) { return key(f, to_string(k), m); }
+Key key(Form f, PrecondKind k, Method m)
+{
+  return key(f, to_string(k), m);
+}
 
 std::map<Key, const Run *> runs_by_key(const Analysis &an)
 {
@@ -196,7 +199,7 @@ std::map<Key, SummaryRow> parse_summary(const std::string &out)
     std::string precond, method, rr, rb, ve, ve_rel, best;
     SummaryRow row;
     t >> precond >> method;
-    if (precond == "precond") continue;  // column header
+    if (precond == "precond") continue; // column header
     t >> row.iterations >> row.stop >> rr >> rb >> ve >> ve_rel >> best >> row.to_target;
     if (t) rows[form + "/" + precond + "/" + method] = row;
   }
@@ -267,7 +270,7 @@ std::map<Key, std::vector<CsvRow>> read_history(std::istream &in, std::string &h
 struct LibraryRun {
   SolveResult result;
   std::vector<CsvRow> rows;
-  int to_target = -1;  // iterations to ve_rel <= kTarget, -1: not reached
+  int to_target = -1; // iterations to ve_rel <= kTarget, -1: not reached
 };
 
 // dv* from the dense K of reference.hpp (independent of the library's kernels and of MUMPS).
@@ -320,11 +323,25 @@ ContactSystem small_pile()
   return sys;
 }
 
-ContactSystem small_pile_prepared() { return prepare_system(small_pile()).system; }
+// The analysis' run against the test's own: same iterations, stop and iterations to kTarget.
+void expect_same_run(const fibre::Run &run, const LibraryRun &lib)
+{
+  EXPECT_EQ(run.result.iterations, lib.result.iterations);
+  EXPECT_EQ(run.result.reason, lib.result.reason);
+  EXPECT_EQ(iterations_to(run, kTarget), lib.to_target);
+}
 
-std::string target_text(int k) { return k >= 0 ? std::to_string(k) : "-"; }
+ContactSystem small_pile_prepared()
+{
+  return prepare_system(small_pile()).system;
+}
 
-}  // namespace
+std::string target_text(int k)
+{
+  return k >= 0 ? std::to_string(k) : "-";
+}
+
+} // namespace
 
 // Every form x method x preconditioner on a 40-sphere pile: the returned runs and their history
 // CSV (write_history_csv) against the test's own runs, and the spectra (write_spectrum) against
@@ -333,7 +350,7 @@ TEST(FibreAnalyze, SummaryCsvAndSpectraMatchTheLibrary)
 {
   const ContactSystem sys = small_pile_prepared();
   AnalysisOptions opt;
-  opt.spectra = true;  // automatic: dense at this size
+  opt.spectra = true; // automatic: dense at this size
   const Analysis an = analyze(sys, opt);
   ASSERT_FALSE(an.zero_rhs);
 
@@ -354,8 +371,8 @@ TEST(FibreAnalyze, SummaryCsvAndSpectraMatchTheLibrary)
   for (Form form : {Form::contact, Form::body}) {
     const double norm_A =
         form == Form::contact ? test::dense_A(sys).norm() : test::dense_K(sys).norm();
-    const int maxiter = static_cast<int>(form == Form::contact ? sys.contact_dofs()
-                                                               : sys.body_dofs());
+    const int maxiter =
+        static_cast<int>(form == Form::contact ? sys.contact_dofs() : sys.body_dofs());
     for (PrecondKind kind : kPreconds)
       for (Method m : kMethods) {
         const Key k = key(form, kind, m);
@@ -365,9 +382,7 @@ TEST(FibreAnalyze, SummaryCsvAndSpectraMatchTheLibrary)
         const LibraryRun lib = library_run(sys, form, kind, m, maxiter, dv_ref, norm_A);
         const fibre::Run &run = *runs.at(k);
         const std::vector<CsvRow> &hist = csv.at(k);
-        EXPECT_EQ(run.result.iterations, lib.result.iterations);
-        EXPECT_EQ(run.result.reason, lib.result.reason);
-        EXPECT_EQ(iterations_to(run, kTarget), lib.to_target);
+        expect_same_run(run, lib);
         reached += lib.to_target >= 0;
         ASSERT_EQ(hist.size(), lib.rows.size());
         // The iterates are the same computation; only ||A||_F and dv* are computed otherwise.
@@ -400,8 +415,7 @@ TEST(FibreAnalyze, SummaryCsvAndSpectraMatchTheLibrary)
       EXPECT_EQ(static_cast<Eigen::Index>(ev.size()), A->size());
       PrecondOptions po;
       po.kind = kind;
-      const Spectrum s =
-          dense_spectrum(*A, *make_preconditioner(form, sys, serial_exchange(), po));
+      const Spectrum s = dense_spectrum(*A, *make_preconditioner(form, sys, serial_exchange(), po));
       EXPECT_NEAR(run->s.kappa_e, s.kappa_e, 1e-3 * s.kappa_e);
       EXPECT_NEAR(effective_condition(ev).kappa_e, s.kappa_e, 1e-9 * s.kappa_e);
     }
@@ -458,7 +472,7 @@ TEST(FibreAnalyze, GhostsAndMaskedRows)
   const ContactSystem pile = pile_scene(30, p);
   ContactSystem sys(pile.bodies(), pile.contacts(), 6, p.spook, pile.num_bodies() - 3);
   std::vector<unsigned char> mask(sys.contact_dofs(), 1);
-  for (std::size_t r = 4; r < mask.size(); r += 6) mask[r] = 0;  // no rolling on axis t1
+  for (std::size_t r = 4; r < mask.size(); r += 6) mask[r] = 0; // no rolling on axis t1
   sys.set_row_mask(mask);
   sys.set_rhs(spook_rhs(sys));
   const fs::path file = dir.path / "ghosts.sys";
@@ -477,9 +491,8 @@ TEST(FibreAnalyze, GhostsAndMaskedRows)
 
 TEST(FibreAnalyzeTool, BadArgumentsAndInputsExitWithStatus2)
 {
-  ASSERT_TRUE(fs::exists(tool_path()))
-      << "fibre_analyze not found at " << tool_path()
-      << " (build the target, or set FIBRE_ANALYZE)";
+  ASSERT_TRUE(fs::exists(tool_path())) << "fibre_analyze not found at " << tool_path()
+                                       << " (build the target, or set FIBRE_ANALYZE)";
   ScratchDir dir("fibre_analyze_bad");
   const fs::path good = dir.path / "good.sys";
   write_system_file(good.string(), small_pile());
@@ -533,11 +546,10 @@ TEST(FibreAnalyzeTool, ShortRunPrintsTheLibrarysResults)
   const ContactSystem sys = small_pile();
   const fs::path file = dir.path / "pile40.sys";
   write_system_file(file.string(), sys);
-  const ToolResult res =
-      run_tool({file.string(), "--form", "body", "--maxiter", "40", "--methods", "uzawa,cr",
-                "--csv", (dir.path / "hist.csv").string(), "--spectra",
-                (dir.path / "spec").string()},
-               dir.path);
+  const ToolResult res = run_tool({file.string(), "--form", "body", "--maxiter", "40", "--methods",
+                                   "uzawa,cr", "--csv", (dir.path / "hist.csv").string(),
+                                   "--spectra", (dir.path / "spec").string()},
+                                  dir.path);
   ASSERT_EQ(res.status, 0) << res.out << res.err;
   EXPECT_NE(res.out.find("Frobenius"), std::string::npos) << "the norm of A must be stated";
 
@@ -552,7 +564,7 @@ TEST(FibreAnalyzeTool, ShortRunPrintsTheLibrarysResults)
   ASSERT_EQ(summary.size(), 10u) << res.out;
   for (const auto &[k, run] : runs_by_key(an)) {
     SCOPED_TRACE(k);
-    ASSERT_TRUE(summary.count(k)) << res.out;  // "cg", not "uzawa"
+    ASSERT_TRUE(summary.count(k)) << res.out; // "cg", not "uzawa"
     EXPECT_EQ(summary.at(k).iterations, run->result.iterations);
     EXPECT_EQ(summary.at(k).stop, to_string(run->result.reason));
     EXPECT_EQ(summary.at(k).to_target, target_text(iterations_to(*run, kTarget)));
@@ -560,7 +572,7 @@ TEST(FibreAnalyzeTool, ShortRunPrintsTheLibrarysResults)
   const auto kappa = parse_kappa(res.out);
   EXPECT_EQ(kappa.size(), 5u) << res.out;
   for (const SpectrumRun &s : an.spectra) {
-    EXPECT_NEAR(kappa.at("body/" + s.precond), s.s.kappa_e, 1e-3 * s.s.kappa_e);  // 4 digits
+    EXPECT_NEAR(kappa.at("body/" + s.precond), s.s.kappa_e, 1e-3 * s.s.kappa_e); // 4 digits
     EXPECT_TRUE(fs::exists(dir.path / ("spec_body_" + s.precond + ".csv"))) << s.precond;
   }
   EXPECT_TRUE(fs::exists(dir.path / "spec_kappa.csv"));
@@ -578,8 +590,7 @@ TEST(FibreAnalyzeTool, ShortRunPrintsTheLibrarysResults)
 // (examples/thesis/plot_convergence.py).
 TEST(FibreAnalyze, LammpsPileBodyFormAgreesWithTheLibrary)
 {
-  ContactSystem pile =
-      lammps_pile_scene(FIBRE_TEST_DATA_DIR "/pile400.dump", SceneParams{});
+  ContactSystem pile = lammps_pile_scene(FIBRE_TEST_DATA_DIR "/pile400.dump", SceneParams{});
   pile.set_rhs(spook_rhs(pile));
   const fs::path out_dir = build_dir() / "tests" / "fibre_analyze";
   fs::create_directories(out_dir);
@@ -661,7 +672,7 @@ class TestSymmetricProduct final : public Preconditioner {
 
 // iterations to ve_rel <= kTarget (-1: not reached) with P on `form`.
 int library_to_target(const ContactSystem &sys, Form form, const LinearOperator &A,
-                              const Preconditioner &P, int maxiter, const Vector &dv_ref)
+                      const Preconditioner &P, int maxiter, const Vector &dv_ref)
 {
   const Exchange &ex = serial_exchange();
   const Vector rhs = form == Form::body ? body_rhs(sys, ex, sys.rhs()) : sys.rhs();
@@ -684,7 +695,7 @@ int library_to_target(const ContactSystem &sys, Form form, const LinearOperator 
   return to_target;
 }
 
-}  // namespace
+} // namespace
 
 // tests/data/material350_step1000.sys: written by `fix fibre_contact ... export 200 snap` in
 // examples/material/in.material at N = 350, step 1000 (the deck of commit dc68075: emitter at
@@ -719,8 +730,7 @@ TEST(FibreAnalyze, ExportedMaterialSystemMatchesTheLibrary)
   const Vector dv_ref = llt.solve(body_rhs(sys, serial_exchange(), sys.rhs()));
   const double floor = 1e-11 * dv_ref.norm();
   for (Form form : {Form::contact, Form::body}) {
-    const double norm_A =
-        form == Form::body ? assemble_K(sys).norm() : assemble_A(sys).norm();
+    const double norm_A = form == Form::body ? assemble_K(sys).norm() : assemble_A(sys).norm();
     for (PrecondKind kind : kPreconds)
       for (Method m : kMethods) {
         const Key k = key(form, kind, m);
@@ -729,9 +739,7 @@ TEST(FibreAnalyze, ExportedMaterialSystemMatchesTheLibrary)
         ASSERT_TRUE(csv.count(k));
         const LibraryRun lib = library_run(sys, form, kind, m, kMaxiter, dv_ref, norm_A);
         const fibre::Run &run = *runs.at(k);
-        EXPECT_EQ(run.result.iterations, lib.result.iterations);
-        EXPECT_EQ(run.result.reason, lib.result.reason);
-        EXPECT_EQ(iterations_to(run, kTarget), lib.to_target);
+        expect_same_run(run, lib);
         const std::vector<CsvRow> &hist = csv.at(k);
         ASSERT_EQ(hist.size(), lib.rows.size());
         const std::size_t at = std::min<std::size_t>(100, hist.size() - 1);

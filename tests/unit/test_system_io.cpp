@@ -9,6 +9,7 @@
 #include <sstream>
 
 #include "fibre/scenes.hpp"
+#include "fibre/spook.hpp"
 #include "fibre/system_io.hpp"
 #include "reference.hpp"
 

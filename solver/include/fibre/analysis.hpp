@@ -38,15 +38,14 @@
 
 namespace fibre {
 
-constexpr int kReportIteration = 100;     // thesis Table 1: r_r and v_e at 100 iterations
-constexpr double kVelocityTarget = 1e-6;  // iterations to ve_rel <= this
+constexpr int kReportIteration = 100;    // thesis Table 1: r_r and v_e at 100 iterations
+constexpr double kVelocityTarget = 1e-6; // iterations to ve_rel <= this
 
 // How the spectra are computed. automatic: dense up to 3000 unknowns; above that the
 // body-space spectrum for the contact form without preconditioner (uniform Sigma), otherwise
 // Lanczos (500 steps), dense after all when that does not converge and n <= 8000.
 enum class KappaMethod { automatic, dense, lanczos };
-template <>
-struct EnumNames<KappaMethod> {
+template <> struct EnumNames<KappaMethod> {
   static constexpr EnumName<KappaMethod> table[] = {{KappaMethod::automatic, "auto"},
                                                     {KappaMethod::dense, "dense"},
                                                     {KappaMethod::lanczos, "lanczos"}};
@@ -58,13 +57,11 @@ struct EnumNames<KappaMethod> {
 //   add_fibre_zs    (F_z^-1 + F_straight^-1) / 2 (two edge weights)
 //   add_tree_zs     (T_z^-1 + T_straight^-1) / 2
 enum class Combination { add_fibre_tree, mul_tree_fibre, add_fibre_zs, add_tree_zs };
-template <>
-struct EnumNames<Combination> {
-  static constexpr EnumName<Combination> table[] = {
-      {Combination::add_fibre_tree, "add_fibre_tree"},
-      {Combination::mul_tree_fibre, "mul_tree_fibre"},
-      {Combination::add_fibre_zs, "add_fibre_zs"},
-      {Combination::add_tree_zs, "add_tree_zs"}};
+template <> struct EnumNames<Combination> {
+  static constexpr EnumName<Combination> table[] = {{Combination::add_fibre_tree, "add_fibre_tree"},
+                                                    {Combination::mul_tree_fibre, "mul_tree_fibre"},
+                                                    {Combination::add_fibre_zs, "add_fibre_zs"},
+                                                    {Combination::add_tree_zs, "add_tree_zs"}};
 };
 
 struct AnalysisOptions {
@@ -72,19 +69,19 @@ struct AnalysisOptions {
   std::vector<Method> methods{Method::cg, Method::cr, Method::minres};
   std::vector<PrecondKind> preconds{PrecondKind::none, PrecondKind::jacobi, PrecondKind::block,
                                     PrecondKind::fibre, PrecondKind::tree};
-  std::vector<Combination> combinations;  // run after `preconds`
-  EdgeWeight weight = EdgeWeight::z;      // of fibre and tree (impulse: from lambda*)
-  int maxiter = 0;                        // 0: the system size of each form
+  std::vector<Combination> combinations; // run after `preconds`
+  EdgeWeight weight = EdgeWeight::z;     // of fibre and tree (impulse: from lambda*)
+  int maxiter = 0;                       // 0: the system size of each form
   bool spectra = false;
   KappaMethod kappa_method = KappaMethod::automatic;
-  int lanczos_steps = 0;  // 0: the default of the kappa method
+  int lanczos_steps = 0; // 0: the default of the kappa method
 };
 
 // ---- the system ----
 
 struct AnalysisSystem {
   ContactSystem system;
-  int ghosts = 0;  // ghost bodies of the export, analysed as ordinary bodies
+  int ghosts = 0; // ghost bodies of the export, analysed as ordinary bodies
 };
 
 // The system as read, rebuilt with every compliance times `sigma_scale` (Sigma scales alike;
@@ -97,12 +94,12 @@ bool uniform_sigma(const ContactSystem &sys);
 
 // What the analysis states about its input; active-row figures are 0 with no active row.
 struct SystemSummary {
-  int walls = 0;            // wall contacts
-  long active_rows = 0;     // rows not masked
+  int walls = 0;        // wall contacts
+  long active_rows = 0; // rows not masked
   long masked_rows = 0;
   double sigma_min = 0, sigma_max = 0;
-  double mean_diag = 0;     // mean diag(G M^-1 G^T) over active rows
-  double mean_sigma = 0;    // mean Sigma over active rows
+  double mean_diag = 0;  // mean diag(G M^-1 G^T) over active rows
+  double mean_sigma = 0; // mean Sigma over active rows
   double rhs_norm = 0;
 };
 SystemSummary summarize(const ContactSystem &sys);
@@ -110,11 +107,11 @@ SystemSummary summarize(const ContactSystem &sys);
 // ---- the direct reference ----
 
 struct Reference {
-  Vector dv;  // dv* = M^-1 G^T lambda*, from the body form
+  Vector dv; // dv* = M^-1 G^T lambda*, from the body form
   double dv_norm = 0;
-  double refinement = 0;  // ||refinement correction|| / ||dv*||: accuracy estimate
-  Vector lambda;          // lambda* from the contact form
-  double contact_velocity_error = 0;  // ||M^-1 G^T lambda* - dv*|| / ||dv*||
+  double refinement = 0;             // ||refinement correction|| / ||dv*||: accuracy estimate
+  Vector lambda;                     // lambda* from the contact form
+  double contact_velocity_error = 0; // ||M^-1 G^T lambda* - dv*|| / ||dv*||
   double seconds = 0;
 };
 Reference direct_reference(const ContactSystem &sys);
@@ -122,11 +119,11 @@ Reference direct_reference(const ContactSystem &sys);
 // ---- one form: operator, rhs, norms, preconditioners ----
 
 struct PrecondEntry {
-  PrecondKind kind = PrecondKind::none;  // of a combination: not meaningful
+  PrecondKind kind = PrecondKind::none; // of a combination: not meaningful
   std::unique_ptr<Preconditioner> P;
-  FibreStats stats;  // fibre and tree
+  FibreStats stats; // fibre and tree
   double setup_seconds = 0;
-  std::string name;  // to_string(kind), or the combination's
+  std::string name; // to_string(kind), or the combination's
   bool combined = false;
 };
 
@@ -135,8 +132,8 @@ struct FormSetup {
   std::unique_ptr<LinearOperator> op;
   Vector rhs;
   double rhs_norm = 0;
-  double norm_fro = 0;  // ||A||_F of the assembled matrix: r_r divides by it
-  double norm_2 = 0;    // ||A||_2 = lambda_max, Lanczos estimate (for comparison)
+  double norm_fro = 0; // ||A||_F of the assembled matrix: r_r divides by it
+  double norm_2 = 0;   // ||A||_2 = lambda_max, Lanczos estimate (for comparison)
   int norm_2_steps = 0;
   int maxiter = 0;
   std::vector<PrecondEntry> preconds;
@@ -159,12 +156,12 @@ struct Run {
   Method method = Method::cg;
   std::string precond;
   SolveResult result;
-  std::vector<IterationRow> rows;  // one per history entry of `result`
+  std::vector<IterationRow> rows; // one per history entry of `result`
   double seconds = 0;
 };
 
-Run run_krylov(const FormSetup &fs, const PrecondEntry &pe, Method method,
-               const ContactSystem &sys, const Reference &ref);
+Run run_krylov(const FormSetup &fs, const PrecondEntry &pe, Method method, const ContactSystem &sys,
+               const Reference &ref);
 
 // The row at kReportIteration, or the last one of a shorter run (nullptr: none).
 const IterationRow *row_at_report(const Run &run);
@@ -178,30 +175,30 @@ int iterations_to(const Run &run, double target = kVelocityTarget);
 struct SpectrumRun {
   Form form = Form::contact;
   PrecondKind kind = PrecondKind::none;
-  std::string precond;  // name
+  std::string precond; // name
   Eigen::Index n = 0;
   Spectrum s;
-  std::string method;    // how it was computed
-  bool complete = true;  // every eigenvalue (false: Lanczos Ritz values)
+  std::string method;   // how it was computed
+  bool complete = true; // every eigenvalue (false: Lanczos Ritz values)
   double seconds = 0;
 };
 
-SpectrumRun compute_spectrum(const FormSetup &fs, const PrecondEntry &pe,
-                             const ContactSystem &sys, KappaMethod how, int lanczos_steps = 0);
+SpectrumRun compute_spectrum(const FormSetup &fs, const PrecondEntry &pe, const ContactSystem &sys,
+                             KappaMethod how, int lanczos_steps = 0);
 
 // ---- the whole analysis ----
 
 struct Analysis {
-  bool zero_rhs = false;  // no Krylov runs, spectra only
-  Reference reference;    // empty when zero_rhs
+  bool zero_rhs = false; // no Krylov runs, spectra only
+  Reference reference;   // empty when zero_rhs
   std::vector<FormSetup> forms;
-  std::vector<Run> runs;  // per form, preconditioner and method, in that order
+  std::vector<Run> runs; // per form, preconditioner and method, in that order
   std::vector<SpectrumRun> spectra;
 };
 
 // Optional hooks, called as the results come (a front end prints progress from them).
 struct AnalysisProgress {
-  std::function<void(const Analysis &)> reference;  // after the reference (or zero_rhs)
+  std::function<void(const Analysis &)> reference; // after the reference (or zero_rhs)
   std::function<void(const FormSetup &)> form;
   std::function<void(const FormSetup &, const Run &)> run;
   std::function<void(const SpectrumRun &)> spectrum;
@@ -224,4 +221,4 @@ std::string spectrum_path(const std::string &prefix, const SpectrumRun &run);
 // The kappa_e table: header, then one line per spectrum.
 void write_kappa_csv(std::ostream &out, const std::vector<SpectrumRun> &runs);
 
-}  // namespace fibre
+} // namespace fibre

@@ -42,4 +42,4 @@ class SymmetricProductPreconditioner final : public Preconditioner {
   mutable Vector Az_, res_, tmp_;
 };
 
-}  // namespace fibre
+} // namespace fibre

@@ -15,9 +15,9 @@ namespace fibre {
 struct SceneParams {
   int rows = 6;
   SpookParams spook{};
-  double compliance = 1e-8;          // eps on every row
-  double contact_tolerance = 0.05;   // pairs with gap < tolerance * mean radius are contacts
-  double max_overlap = 0.01;         // random overlap added to gaps, times the mean radius
+  double compliance = 1e-8;        // eps on every row
+  double contact_tolerance = 0.05; // pairs with gap < tolerance * mean radius are contacts
+  double max_overlap = 0.01;       // random overlap added to gaps, times the mean radius
   std::uint64_t seed = 1;
 };
 
@@ -53,4 +53,4 @@ std::vector<Body> read_sphere_dump(const std::string &path, double gravity = 9.8
 // floor and four side walls.
 ContactSystem lammps_pile_scene(const std::string &dump_path, const SceneParams &p);
 
-}  // namespace fibre
+} // namespace fibre
