@@ -256,48 +256,6 @@ TEST(Fibres, EdgeWeights)
   EXPECT_DOUBLE_EQ(edge_weight(sys, EdgeWeight::impulse, &imp, 1, 0, Vec3::Zero()), -2.5);
 }
 
-TEST(Fibres, RelabellingPreservesTheSystem)
-{
-  for (int ghosts : {0, 40}) {
-    const ContactSystem orig = with_ghosts(pile_scene(200, SceneParams{}), ghosts);
-    ContactSystem sys = orig;
-    Fibres f = build_fibres(sys, EdgeWeight::z, nullptr, true);
-    const Fibres before = f;
-    const Relabelling r = relabel_system(sys, f);
-    // Fibre contacts are consecutive and in chain order in the new numbering.
-    for (std::size_t q = 0; q < f.contacts.size(); ++q) EXPECT_EQ(f.contacts[q], int(q));
-    for (int k = 0; k < f.num_fibres(); ++k)
-      for (int q = 0; q < f.length(k); ++q) {
-        const Contact &c = sys.contacts()[f.contact_start[k] + q];
-        const int u = f.bodies[f.body_start[k] + q], v = f.bodies[f.body_start[k] + q + 1];
-        EXPECT_TRUE((c.a == u && c.b == v) || (c.a == v && c.b == u));
-      }
-    if (ghosts == 0) {  // all owned: fibre bodies are 0, 1, 2, ... too
-      for (std::size_t q = 0; q < f.bodies.size(); ++q) EXPECT_EQ(f.bodies[q], int(q));
-    }
-    EXPECT_EQ(f.stats.contacts_in_fibres, before.stats.contacts_in_fibres);
-    expect_valid_fibres(sys, f, true);
-    // Same operator up to the permutation: A' P x = P A x, and the same for K and b.
-    const Vector x = Vector::Random(orig.contact_dofs());
-    Vector y, y2;
-    ContactSpaceOperator(orig, serial_exchange()).apply(x, y);
-    ContactSpaceOperator(sys, serial_exchange())
-        .apply(relabel_contact_vector(r, sys.rows(), x), y2);
-    EXPECT_LT((y2 - relabel_contact_vector(r, sys.rows(), y)).norm(), 1e-12 * y.norm());
-    EXPECT_LT((sys.rhs() - relabel_contact_vector(r, sys.rows(), orig.rhs())).norm(),
-              1e-14 * orig.rhs().norm());
-    const Vector v = Vector::Random(orig.body_dofs());
-    Vector pv(v.size()), kv, kv2;
-    for (int i = 0; i < orig.num_bodies(); ++i)
-      pv.segment<6>(6 * r.new_body[i]) = v.segment<6>(6 * i);
-    BodySpaceOperator(orig, serial_exchange()).apply(v, kv);
-    BodySpaceOperator(sys, serial_exchange()).apply(pv, kv2);
-    for (int i = 0; i < orig.num_owned_bodies(); ++i)
-      EXPECT_LT((kv2.segment<6>(6 * r.new_body[i]) - kv.segment<6>(6 * i)).norm(),
-                1e-12 * kv.norm());
-  }
-}
-
 TEST(Forest, SpanningForestProperties)
 {
   for (EdgeWeight w : kWeights)
