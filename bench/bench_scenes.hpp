@@ -12,10 +12,13 @@
 #pragma once
 
 #include <cmath>
+#include <map>
+#include <memory>
 #include <random>
 #include <vector>
 
 #include "fibre/scenes.hpp"
+#include "fibre/spook.hpp"
 
 namespace fibre::bench {
 
@@ -69,13 +72,12 @@ inline ContactSystem heap_scene(int n, std::uint64_t seed = 1)
     const double jit = 0.005 * s;
     body.x = Vec3(x + jit * (2 * uni(rng) - 1), y + jit * (2 * uni(rng) - 1),
                   std::max(body.radius, z + jit * (2 * uni(rng) - 1)));
-    body.v = Vec3(0.01 * (2 * uni(rng) - 1), 0.01 * (2 * uni(rng) - 1),
-                  0.01 * (2 * uni(rng) - 1));
+    body.v = Vec3(0.01 * (2 * uni(rng) - 1), 0.01 * (2 * uni(rng) - 1), 0.01 * (2 * uni(rng) - 1));
     body.force = Vec3(0, 0, -9.81 * body.mass);
     bodies.push_back(body);
   }
   SceneParams p = material_params();
-  p.contact_tolerance = 0.04 / 0.48;  // tolerance * mean radius = 0.04 s
+  p.contact_tolerance = 0.04 / 0.48; // tolerance * mean radius = 0.04 s
   p.seed = seed;
   ContactSystem sys = packing_scene(std::move(bodies), {Plane{Vec3::UnitZ(), 0.0}}, p);
   // Rotational rows 8x softer, as in the material deck's export.
@@ -93,4 +95,14 @@ inline int heap_bodies_for(int contacts)
   return std::max(8, contacts / 3);
 }
 
-}  // namespace fibre::bench
+// heap_scene for about `contacts` contacts, built once per count and kept for the program's
+// life (the benchmarks of one size share it).
+inline const ContactSystem &cached_heap_scene(int contacts)
+{
+  static std::map<int, std::unique_ptr<ContactSystem>> cache;
+  auto &slot = cache[contacts];
+  if (!slot) slot = std::make_unique<ContactSystem>(heap_scene(heap_bodies_for(contacts)));
+  return *slot;
+}
+
+} // namespace fibre::bench

@@ -32,15 +32,6 @@ using namespace fibre;
 
 namespace {
 
-const ContactSystem &scene(int contacts)
-{
-  static std::map<int, std::unique_ptr<ContactSystem>> cache;
-  auto &slot = cache[contacts];
-  if (!slot)
-    slot = std::make_unique<ContactSystem>(bench::heap_scene(bench::heap_bodies_for(contacts)));
-  return *slot;
-}
-
 double product_bytes(const ContactSystem &sys, Form form)
 {
   const double r = sys.rows();
@@ -50,7 +41,7 @@ double product_bytes(const ContactSystem &sys, Form form)
 
 template <Form F> void BM_Product(benchmark::State &state)
 {
-  const ContactSystem &sys = scene(static_cast<int>(state.range(0)));
+  const ContactSystem &sys = bench::cached_heap_scene(static_cast<int>(state.range(0)));
   const auto op = make_operator(F, sys, serial_exchange());
   const Vector x = Vector::Ones(op->size());
   Vector y;
@@ -102,7 +93,7 @@ void sizes(benchmark::internal::Benchmark *b)
 
 class TableReporter : public benchmark::ConsoleReporter {
  public:
-  std::map<std::string, double> gbps;  // full name -> GB/s
+  std::map<std::string, double> gbps; // full name -> GB/s
   std::map<std::string, double> contacts;
   void ReportRuns(const std::vector<Run> &reports) override
   {
@@ -110,7 +101,7 @@ class TableReporter : public benchmark::ConsoleReporter {
       // Rates are per second of CPU time (the machine is shared: wall time includes waits).
       const std::string name = r.run_name.function_name + "/" + r.run_name.args;
       const auto b = r.counters.find("bytes_per_second");
-      if (b != r.counters.end()) gbps[name] = double(b->second) / 1e9;  // bytes per CPU second
+      if (b != r.counters.end()) gbps[name] = double(b->second) / 1e9; // bytes per CPU second
       const auto c = r.counters.find("contacts");
       if (c != r.counters.end()) contacts[name] = double(c->second);
     }
@@ -118,7 +109,7 @@ class TableReporter : public benchmark::ConsoleReporter {
   }
 };
 
-}  // namespace
+} // namespace
 
 BENCHMARK(BM_Triad)->Name("stream_triad")->Arg(128)->Unit(benchmark::kMillisecond)->MinTime(0.5);
 BENCHMARK(BM_Copy)->Name("stream_copy")->Arg(128)->Unit(benchmark::kMillisecond)->MinTime(0.5);

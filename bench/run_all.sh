@@ -21,7 +21,7 @@ sys_args=()
 for f in ${SYS_FILES:-}; do sys_args+=(--sys "$f"); done
 
 "$b/bench_schur" > "$out/schur.txt" 2>&1
-"$b/bench_precond_scaling" > "$out/precond_scaling.txt" 2>&1
+"$b/bench_precond" > "$out/precond.txt" 2>&1
 "$src/bench/profile.sh" "$build" 15000 3 > "$out/profile.txt" 2>&1
 "${blas_env[@]}" "$b/bench_direct_vs_krylov" --repeat 3 "${sys_args[@]}" > "$out/direct_vs_krylov.txt" 2>&1
 if [ -z "${SKIP_MPI:-}" ]; then

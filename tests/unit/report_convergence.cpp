@@ -24,6 +24,7 @@
 #include "fibre/krylov.hpp"
 #include "fibre/preconditioner_family.hpp"
 #include "fibre/scenes.hpp"
+#include "fibre/spook.hpp"
 
 using namespace fibre;
 

@@ -5,6 +5,7 @@
 #include "fibre/assembly.hpp"
 #include "fibre/kernels.hpp"
 #include "fibre/scenes.hpp"
+#include "fibre/spook.hpp"
 #include "reference.hpp"
 
 using namespace fibre;

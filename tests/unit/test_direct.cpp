@@ -18,6 +18,7 @@
 #include "fibre/direct.hpp"
 #include "fibre/scenes.hpp"
 #include "fibre/spectra.hpp"
+#include "fibre/spook.hpp"
 #include "reference.hpp"
 
 using namespace fibre;

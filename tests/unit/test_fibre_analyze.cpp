@@ -1,6 +1,8 @@
-// fibre_analyze (tools/fibre_analyze.cpp) run as a program on system files written here, its
-// printed summary, CSV and spectra checked against the same quantities recomputed through the
-// library API, with an independent dense reference for the exact velocities.
+// fibre/analysis.hpp (what fibre_analyze computes) called in-process on systems made here,
+// its returned histories, spectra and CSV writers checked against the same quantities
+// recomputed through the library API, with an independent dense reference for the exact
+// velocities. Two tests run the fibre_analyze program itself: its argument and input errors,
+// and one short run whose printed summary must be the library's.
 //
 // The tool is found next to this test in the build tree (<build>/tools/fibre_analyze, from
 // <build>/tests/test_fibre_analyze), or where the environment variable FIBRE_ANALYZE says. It
@@ -23,12 +25,13 @@
 #include <string>
 #include <vector>
 
-#include "fibre/spook.hpp"
+#include "fibre/analysis.hpp"
 #include "fibre/assembly.hpp"
 #include "fibre/krylov.hpp"
 #include "fibre/preconditioner_family.hpp"
 #include "fibre/scenes.hpp"
 #include "fibre/spectra.hpp"
+#include "fibre/spook.hpp"
 #include "fibre/system_io.hpp"
 #include "reference.hpp"
 
@@ -42,7 +45,7 @@ namespace {
 const PrecondKind kPreconds[] = {PrecondKind::none, PrecondKind::jacobi, PrecondKind::block,
                                  PrecondKind::fibre, PrecondKind::tree};
 const Method kMethods[] = {Method::cg, Method::cr, Method::minres};
-constexpr double kTarget = 1e-6;  // the tool's "to_1e-6" column
+constexpr double kTarget = 1e-6; // the tool's "to_1e-6" column
 
 fs::path build_dir()
 {
@@ -56,7 +59,7 @@ fs::path tool_path()
 }
 
 struct ToolResult {
-  int status = -1;  // exit status, -1: did not exit normally
+  int status = -1; // exit status, -1: did not exit normally
   std::string out, err;
 };
 
@@ -127,17 +130,50 @@ struct ScratchDir {
   }
 };
 
+// ---- the analysis' results ----
+
+using Key = std::string; // "form/precond/method"
+Key key(Form f, const std::string &precond, Method m)
+{
+  return std::string(to_string(f)) + "/" + precond + "/" + to_string(m);
+}
+Key key(Form f, PrecondKind k, Method m)
+{
+  return key(f, to_string(k), m);
+}
+
+std::map<Key, const Run *> runs_by_key(const Analysis &an)
+{
+  std::map<Key, const Run *> out;
+  for (const Run &r : an.runs) out[key(r.form, r.precond, r.method)] = &r;
+  return out;
+}
+
+const SpectrumRun *find_spectrum(const Analysis &an, Form form, const std::string &precond)
+{
+  for (const SpectrumRun &s : an.spectra)
+    if (s.form == form && s.precond == precond) return &s;
+  return nullptr;
+}
+
+// The eigenvalues as write_spectrum writes them (comment lines skipped).
+std::vector<double> written_eigenvalues(const SpectrumRun &run)
+{
+  std::stringstream file;
+  write_spectrum(file, run);
+  std::vector<double> ev;
+  std::string line;
+  while (std::getline(file, line))
+    if (!line.empty() && line[0] != '#') ev.push_back(std::stod(line));
+  return ev;
+}
+
 // ---- parsing the tool's output ----
 
 struct SummaryRow {
   int iterations = 0;
   std::string stop, to_target;
 };
-using Key = std::string;  // "form/precond/method"
-Key key(Form f, PrecondKind k, Method m)
-{
-  return std::string(to_string(f)) + "/" + to_string(k) + "/" + to_string(m);
-}
 
 // The rows of the "== <form> form runs" tables.
 std::map<Key, SummaryRow> parse_summary(const std::string &out)
@@ -163,7 +199,7 @@ std::map<Key, SummaryRow> parse_summary(const std::string &out)
     std::string precond, method, rr, rb, ve, ve_rel, best;
     SummaryRow row;
     t >> precond >> method;
-    if (precond == "precond") continue;  // column header
+    if (precond == "precond") continue; // column header
     t >> row.iterations >> row.stop >> rr >> rb >> ve >> ve_rel >> best >> row.to_target;
     if (t) rows[form + "/" + precond + "/" + method] = row;
   }
@@ -195,11 +231,10 @@ struct CsvRow {
 };
 
 // The history CSV: comment lines (#), the header, then one row per iteration.
-std::map<Key, std::vector<CsvRow>> read_history(const fs::path &path, std::string &header,
+std::map<Key, std::vector<CsvRow>> read_history(std::istream &in, std::string &header,
                                                 std::map<std::string, long> &sizes)
 {
   std::map<Key, std::vector<CsvRow>> runs;
-  std::ifstream in(path);
   std::string line;
   while (std::getline(in, line)) {
     if (line.rfind("# size ", 0) == 0) {
@@ -235,7 +270,7 @@ std::map<Key, std::vector<CsvRow>> read_history(const fs::path &path, std::strin
 struct LibraryRun {
   SolveResult result;
   std::vector<CsvRow> rows;
-  std::string to_target = "-";
+  int to_target = -1; // iterations to ve_rel <= kTarget, -1: not reached
 };
 
 // dv* from the dense K of reference.hpp (independent of the library's kernels and of MUMPS).
@@ -274,7 +309,7 @@ LibraryRun library_run(const ContactSystem &sys, Form form, PrecondKind kind, Me
   run.result = krylov_solve(method, *A, *P, rhs, x, stop, &mon);
   for (std::size_t k = 0; k < run.rows.size(); ++k)
     if (run.rows[k].ve_rel <= kTarget) {
-      run.to_target = std::to_string(k);
+      run.to_target = static_cast<int>(k);
       break;
     }
   return run;
@@ -288,58 +323,67 @@ ContactSystem small_pile()
   return sys;
 }
 
-}  // namespace
-
-TEST(FibreAnalyze, ToolIsBuilt)
+// The analysis' run against the test's own: same iterations, stop and iterations to kTarget.
+void expect_same_run(const fibre::Run &run, const LibraryRun &lib)
 {
-  ASSERT_TRUE(fs::exists(tool_path()))
-      << "fibre_analyze not found at " << tool_path()
-      << " (build the target, or set FIBRE_ANALYZE)";
+  EXPECT_EQ(run.result.iterations, lib.result.iterations);
+  EXPECT_EQ(run.result.reason, lib.result.reason);
+  EXPECT_EQ(iterations_to(run, kTarget), lib.to_target);
 }
 
+ContactSystem small_pile_prepared()
+{
+  return prepare_system(small_pile()).system;
+}
+
+std::string target_text(int k)
+{
+  return k >= 0 ? std::to_string(k) : "-";
+}
+
+} // namespace
+
+// Every form x method x preconditioner on a 40-sphere pile: the returned runs and their history
+// CSV (write_history_csv) against the test's own runs, and the spectra (write_spectrum) against
+// dense ones. Formerly parsed from the tool's printed summary and files.
 TEST(FibreAnalyze, SummaryCsvAndSpectraMatchTheLibrary)
 {
-  ScratchDir dir("fibre_analyze_small");
-  const ContactSystem sys = small_pile();
-  const fs::path file = dir.path / "pile40.sys";
-  write_system_file(file.string(), sys);
-  const ToolResult res = run_tool(
-      {file.string(), "--csv", (dir.path / "hist.csv").string(), "--spectra",
-       (dir.path / "spec").string()},
-      dir.path);
-  ASSERT_EQ(res.status, 0) << res.out << res.err;
-  EXPECT_NE(res.out.find("Frobenius"), std::string::npos) << "the norm of A must be stated";
+  const ContactSystem sys = small_pile_prepared();
+  AnalysisOptions opt;
+  opt.spectra = true; // automatic: dense at this size
+  const Analysis an = analyze(sys, opt);
+  ASSERT_FALSE(an.zero_rhs);
 
   // Default maxiter: the system size of each form.
+  std::stringstream csv_text;
+  write_history_csv(csv_text, an, "pile40.sys", 1.0);
   std::string header;
   std::map<std::string, long> sizes;
-  const auto csv = read_history(dir.path / "hist.csv", header, sizes);
+  const auto csv = read_history(csv_text, header, sizes);
   EXPECT_EQ(header, "form,method,precond,iteration,rr,rb,ve,ve_rel");
   EXPECT_EQ(sizes["contact"], long(sys.contact_dofs()));
   EXPECT_EQ(sizes["body"], long(sys.body_dofs()));
 
-  const auto summary = parse_summary(res.out);
-  EXPECT_EQ(summary.size(), 30u) << res.out;
+  const auto runs = runs_by_key(an);
+  EXPECT_EQ(runs.size(), 30u);
   const Vector dv_ref = dense_reference_dv(sys);
   int reached = 0;
   for (Form form : {Form::contact, Form::body}) {
     const double norm_A =
         form == Form::contact ? test::dense_A(sys).norm() : test::dense_K(sys).norm();
-    const int maxiter = static_cast<int>(form == Form::contact ? sys.contact_dofs()
-                                                               : sys.body_dofs());
+    const int maxiter =
+        static_cast<int>(form == Form::contact ? sys.contact_dofs() : sys.body_dofs());
     for (PrecondKind kind : kPreconds)
       for (Method m : kMethods) {
         const Key k = key(form, kind, m);
         SCOPED_TRACE(k);
-        ASSERT_TRUE(summary.count(k)) << res.out;
+        ASSERT_TRUE(runs.count(k));
         ASSERT_TRUE(csv.count(k));
         const LibraryRun lib = library_run(sys, form, kind, m, maxiter, dv_ref, norm_A);
-        const SummaryRow &row = summary.at(k);
+        const fibre::Run &run = *runs.at(k);
         const std::vector<CsvRow> &hist = csv.at(k);
-        EXPECT_EQ(row.iterations, lib.result.iterations);
-        EXPECT_EQ(row.stop, to_string(lib.result.reason));
-        EXPECT_EQ(row.to_target, lib.to_target);
-        reached += row.to_target != "-";
+        expect_same_run(run, lib);
+        reached += lib.to_target >= 0;
         ASSERT_EQ(hist.size(), lib.rows.size());
         // The iterates are the same computation; only ||A||_F and dv* are computed otherwise.
         const std::size_t at = std::min<std::size_t>(100, hist.size() - 1);
@@ -357,28 +401,22 @@ TEST(FibreAnalyze, SummaryCsvAndSpectraMatchTheLibrary)
   }
   EXPECT_GE(reached, 5) << "too few runs reach the target for the check to mean much";
 
-  // Spectra: one file per form x preconditioner, all eigenvalues (dense at this size), and
-  // the printed kappa_e equal to the library's.
-  const auto kappa = parse_kappa(res.out);
-  EXPECT_EQ(kappa.size(), 10u) << res.out;
+  // Spectra: one per form x preconditioner, all eigenvalues (dense at this size), kappa_e
+  // equal to the library's.
+  EXPECT_EQ(an.spectra.size(), 10u);
   for (Form form : {Form::contact, Form::body}) {
     const auto A = make_operator(form, sys, serial_exchange());
     for (PrecondKind kind : kPreconds) {
-      const std::string name = std::string(to_string(form)) + "_" + to_string(kind);
-      SCOPED_TRACE(name);
-      std::ifstream in(dir.path / ("spec_" + name + ".csv"));
-      ASSERT_TRUE(in) << "missing spectrum file";
-      std::vector<double> ev;
-      std::string line;
-      while (std::getline(in, line))
-        if (!line.empty() && line[0] != '#') ev.push_back(std::stod(line));
+      SCOPED_TRACE(std::string(to_string(form)) + "_" + to_string(kind));
+      const SpectrumRun *run = find_spectrum(an, form, to_string(kind));
+      ASSERT_NE(run, nullptr) << "missing spectrum";
+      EXPECT_TRUE(run->complete);
+      const std::vector<double> ev = written_eigenvalues(*run);
       EXPECT_EQ(static_cast<Eigen::Index>(ev.size()), A->size());
       PrecondOptions po;
       po.kind = kind;
-      const Spectrum s =
-          dense_spectrum(*A, *make_preconditioner(form, sys, serial_exchange(), po));
-      const double printed = kappa.at(std::string(to_string(form)) + "/" + to_string(kind));
-      EXPECT_NEAR(printed, s.kappa_e, 1e-3 * s.kappa_e);  // printed with 4 digits
+      const Spectrum s = dense_spectrum(*A, *make_preconditioner(form, sys, serial_exchange(), po));
+      EXPECT_NEAR(run->s.kappa_e, s.kappa_e, 1e-3 * s.kappa_e);
       EXPECT_NEAR(effective_condition(ev).kappa_e, s.kappa_e, 1e-9 * s.kappa_e);
     }
   }
@@ -386,43 +424,47 @@ TEST(FibreAnalyze, SummaryCsvAndSpectraMatchTheLibrary)
   Eigen::SelfAdjointEigenSolver<test::Dense> es(test::dense_A(sys), Eigen::EigenvaluesOnly);
   const Vector ev = es.eigenvalues();
   const double ke = effective_condition({ev.data(), ev.data() + ev.size()}).kappa_e;
-  EXPECT_NEAR(kappa.at("contact/none"), ke, 1e-3 * ke);
+  EXPECT_NEAR(find_spectrum(an, Form::contact, "none")->s.kappa_e, ke, 1e-3 * ke);
 }
 
 TEST(FibreAnalyze, SigmaScaleChangesSigmaOnly)
 {
-  ScratchDir dir("fibre_analyze_sigma");
   const ContactSystem sys = small_pile();
-  const fs::path file = dir.path / "pile40.sys";
-  write_system_file(file.string(), sys);
   const double scale = 1e-3;
-  const ToolResult res =
-      run_tool({file.string(), "--sigma-scale", "1e-3", "--form", "body", "--precond",
-                "block", "--methods", "cr", "--maxiter", "120", "--kappa", "dense"},
-               dir.path);
-  ASSERT_EQ(res.status, 0) << res.out << res.err;
-  // The same system with every compliance scaled, through the library.
+  const ContactSystem prepared = prepare_system(sys, scale).system;
+  // The same system with every compliance scaled, by hand.
   std::vector<Contact> contacts = sys.contacts();
   for (Contact &c : contacts)
     for (double &eps : c.compliance) eps *= scale;
   ContactSystem scaled(sys.bodies(), contacts, sys.rows(), sys.params());
   scaled.set_rhs(sys.rhs());
   EXPECT_NEAR(scaled.sigma()[0], scale * sys.sigma()[0], 1e-15 * sys.sigma()[0]);
-  const auto summary = parse_summary(res.out);
-  ASSERT_EQ(summary.size(), 1u) << res.out;
-  const Key k = key(Form::body, PrecondKind::block, Method::cr);
+  EXPECT_EQ((prepared.sigma() - scaled.sigma()).norm(), 0.0);
+  EXPECT_EQ((prepared.rhs() - sys.rhs()).norm(), 0.0);
+
+  AnalysisOptions opt;
+  opt.forms = {Form::body};
+  opt.preconds = {PrecondKind::block};
+  opt.methods = {Method::cr};
+  opt.maxiter = 120;
+  opt.spectra = true;
+  opt.kappa_method = KappaMethod::dense;
+  const Analysis an = analyze(prepared, opt);
+  ASSERT_EQ(an.runs.size(), 1u);
   const LibraryRun lib = library_run(scaled, Form::body, PrecondKind::block, Method::cr, 120,
                                      dense_reference_dv(scaled), test::dense_K(scaled).norm());
-  EXPECT_EQ(summary.at(k).to_target, lib.to_target);
-  EXPECT_EQ(summary.at(k).iterations, lib.result.iterations);
+  EXPECT_EQ(iterations_to(an.runs[0], kTarget), lib.to_target);
+  EXPECT_EQ(an.runs[0].result.iterations, lib.result.iterations);
   PrecondOptions po;
   po.kind = PrecondKind::block;
   const Spectrum s =
       dense_spectrum(BodySpaceOperator(scaled, serial_exchange()),
                      *make_preconditioner(Form::body, scaled, serial_exchange(), po));
-  EXPECT_NEAR(parse_kappa(res.out).at("body/block"), s.kappa_e, 1e-3 * s.kappa_e);
+  ASSERT_EQ(an.spectra.size(), 1u);
+  EXPECT_NEAR(an.spectra[0].s.kappa_e, s.kappa_e, 1e-3 * s.kappa_e);
 }
 
+// Formerly read from the tool's printed description ("3 ghost bodies", "(N masked)").
 TEST(FibreAnalyze, GhostsAndMaskedRows)
 {
   ScratchDir dir("fibre_analyze_ghosts");
@@ -430,22 +472,27 @@ TEST(FibreAnalyze, GhostsAndMaskedRows)
   const ContactSystem pile = pile_scene(30, p);
   ContactSystem sys(pile.bodies(), pile.contacts(), 6, p.spook, pile.num_bodies() - 3);
   std::vector<unsigned char> mask(sys.contact_dofs(), 1);
-  for (std::size_t r = 4; r < mask.size(); r += 6) mask[r] = 0;  // no rolling on axis t1
+  for (std::size_t r = 4; r < mask.size(); r += 6) mask[r] = 0; // no rolling on axis t1
   sys.set_row_mask(mask);
   sys.set_rhs(spook_rhs(sys));
   const fs::path file = dir.path / "ghosts.sys";
   write_system_file(file.string(), sys);
-  const ToolResult res = run_tool({file.string(), "--maxiter", "50", "--kappa", "auto"}, dir.path);
-  ASSERT_EQ(res.status, 0) << res.out << res.err;
-  EXPECT_NE(res.out.find("3 ghost bodies"), std::string::npos) << res.out;
-  const std::string masked = "(" + std::to_string(sys.num_contacts()) + " masked)";
-  EXPECT_NE(res.out.find(masked), std::string::npos) << res.out;
-  EXPECT_EQ(parse_summary(res.out).size(), 30u) << res.out;
-  EXPECT_EQ(parse_kappa(res.out).size(), 10u) << res.out;
+  const AnalysisSystem in = prepare_system(read_system_file(file.string()));
+  EXPECT_EQ(in.ghosts, 3);
+  EXPECT_EQ(in.system.num_owned_bodies(), in.system.num_bodies());
+  EXPECT_EQ(summarize(in.system).masked_rows, long(sys.num_contacts()));
+  AnalysisOptions opt;
+  opt.maxiter = 50;
+  opt.spectra = true;
+  const Analysis an = analyze(in.system, opt);
+  EXPECT_EQ(runs_by_key(an).size(), 30u);
+  EXPECT_EQ(an.spectra.size(), 10u);
 }
 
-TEST(FibreAnalyze, BadArgumentsAndInputsExitWithStatus2)
+TEST(FibreAnalyzeTool, BadArgumentsAndInputsExitWithStatus2)
 {
+  ASSERT_TRUE(fs::exists(tool_path())) << "fibre_analyze not found at " << tool_path()
+                                       << " (build the target, or set FIBRE_ANALYZE)";
   ScratchDir dir("fibre_analyze_bad");
   const fs::path good = dir.path / "good.sys";
   write_system_file(good.string(), small_pile());
@@ -492,24 +539,69 @@ TEST(FibreAnalyze, BadArgumentsAndInputsExitWithStatus2)
   EXPECT_NE(help.out.find("usage: fibre_analyze SYSTEM_FILE"), std::string::npos);
 }
 
+// One short run of the program: its printed summary must be the library's, its files written.
+TEST(FibreAnalyzeTool, ShortRunPrintsTheLibrarysResults)
+{
+  ScratchDir dir("fibre_analyze_small");
+  const ContactSystem sys = small_pile();
+  const fs::path file = dir.path / "pile40.sys";
+  write_system_file(file.string(), sys);
+  const ToolResult res = run_tool({file.string(), "--form", "body", "--maxiter", "40", "--methods",
+                                   "uzawa,cr", "--csv", (dir.path / "hist.csv").string(),
+                                   "--spectra", (dir.path / "spec").string()},
+                                  dir.path);
+  ASSERT_EQ(res.status, 0) << res.out << res.err;
+  EXPECT_NE(res.out.find("Frobenius"), std::string::npos) << "the norm of A must be stated";
+
+  AnalysisOptions opt;
+  opt.forms = {Form::body};
+  opt.methods = {Method::cg, Method::cr};
+  opt.maxiter = 40;
+  opt.spectra = true;
+  const AnalysisSystem in = prepare_system(read_system_file(file.string()));
+  const Analysis an = analyze(in.system, opt);
+  const auto summary = parse_summary(res.out);
+  ASSERT_EQ(summary.size(), 10u) << res.out;
+  for (const auto &[k, run] : runs_by_key(an)) {
+    SCOPED_TRACE(k);
+    ASSERT_TRUE(summary.count(k)) << res.out; // "cg", not "uzawa"
+    EXPECT_EQ(summary.at(k).iterations, run->result.iterations);
+    EXPECT_EQ(summary.at(k).stop, to_string(run->result.reason));
+    EXPECT_EQ(summary.at(k).to_target, target_text(iterations_to(*run, kTarget)));
+  }
+  const auto kappa = parse_kappa(res.out);
+  EXPECT_EQ(kappa.size(), 5u) << res.out;
+  for (const SpectrumRun &s : an.spectra) {
+    EXPECT_NEAR(kappa.at("body/" + s.precond), s.s.kappa_e, 1e-3 * s.s.kappa_e); // 4 digits
+    EXPECT_TRUE(fs::exists(dir.path / ("spec_body_" + s.precond + ".csv"))) << s.precond;
+  }
+  EXPECT_TRUE(fs::exists(dir.path / "spec_kappa.csv"));
+  std::ifstream hist(dir.path / "hist.csv");
+  std::string header;
+  std::map<std::string, long> sizes;
+  EXPECT_EQ(read_history(hist, header, sizes).size(), 10u);
+  EXPECT_EQ(header, "form,method,precond,iteration,rr,rb,ve,ve_rel");
+  EXPECT_EQ(sizes["body"], long(sys.body_dofs()));
+}
+
 // The LAMMPS-poured pile (tests/data/pile400.dump): the body form reaches ve_rel <= 1e-6 in
 // 33-57 iterations whatever the preconditioner (doc/convergence_pile400.txt). The system file
 // is left in <build>/tests/fibre_analyze/pile400.sys for fibre_analyze runs by hand
 // (examples/thesis/plot_convergence.py).
 TEST(FibreAnalyze, LammpsPileBodyFormAgreesWithTheLibrary)
 {
-  ContactSystem pile =
-      lammps_pile_scene(FIBRE_TEST_DATA_DIR "/pile400.dump", SceneParams{});
+  ContactSystem pile = lammps_pile_scene(FIBRE_TEST_DATA_DIR "/pile400.dump", SceneParams{});
   pile.set_rhs(spook_rhs(pile));
   const fs::path out_dir = build_dir() / "tests" / "fibre_analyze";
   fs::create_directories(out_dir);
-  const fs::path file = out_dir / "pile400.sys";
-  write_system_file(file.string(), pile);
-  const ToolResult res =
-      run_tool({file.string(), "--form", "body", "--maxiter", "100"}, out_dir);
-  ASSERT_EQ(res.status, 0) << res.out << res.err;
-  const auto summary = parse_summary(res.out);
-  ASSERT_EQ(summary.size(), 15u) << res.out;
+  write_system_file((out_dir / "pile400.sys").string(), pile);
+  AnalysisOptions opt;
+  opt.forms = {Form::body};
+  opt.maxiter = 100;
+  const AnalysisSystem in = prepare_system(pile);
+  const Analysis an = analyze(in.system, opt);
+  const auto runs = runs_by_key(an);
+  ASSERT_EQ(runs.size(), 15u);
 
   // Reference velocities from a sparse Cholesky of the library's assembled K.
   Eigen::SimplicialLLT<SparseMatrix> llt(assemble_K(pile));
@@ -521,11 +613,11 @@ TEST(FibreAnalyze, LammpsPileBodyFormAgreesWithTheLibrary)
       const Key k = key(Form::body, kind, m);
       SCOPED_TRACE(k);
       const LibraryRun lib = library_run(pile, Form::body, kind, m, 100, dv_ref, norm_K);
-      const SummaryRow &row = summary.at(k);
-      EXPECT_EQ(row.to_target, lib.to_target);
-      ASSERT_NE(row.to_target, "-");
-      EXPECT_GE(std::stoi(row.to_target), 25);
-      EXPECT_LE(std::stoi(row.to_target), 65);
+      const int to_target = iterations_to(*runs.at(k), kTarget);
+      EXPECT_EQ(to_target, lib.to_target);
+      ASSERT_GE(to_target, 0);
+      EXPECT_GE(to_target, 25);
+      EXPECT_LE(to_target, 65);
     }
 }
 
@@ -533,7 +625,7 @@ TEST(FibreAnalyze, LammpsPileBodyFormAgreesWithTheLibrary)
 
 namespace {
 
-// Test-side twins of fibre_analyze's --combine preconditioners.
+// Test-side twins of combined_preconditioner.hpp (independent of the library's).
 class TestAverage final : public Preconditioner {
  public:
   TestAverage(std::unique_ptr<Preconditioner> a, std::unique_ptr<Preconditioner> b)
@@ -578,20 +670,20 @@ class TestSymmetricProduct final : public Preconditioner {
   std::unique_ptr<Preconditioner> o_, i_;
 };
 
-// iterations to ve_rel <= kTarget ("-": not reached) with P on `form`.
-std::string library_to_target(const ContactSystem &sys, Form form, const LinearOperator &A,
-                              const Preconditioner &P, int maxiter, const Vector &dv_ref)
+// iterations to ve_rel <= kTarget (-1: not reached) with P on `form`.
+int library_to_target(const ContactSystem &sys, Form form, const LinearOperator &A,
+                      const Preconditioner &P, int maxiter, const Vector &dv_ref)
 {
   const Exchange &ex = serial_exchange();
   const Vector rhs = form == Form::body ? body_rhs(sys, ex, sys.rhs()) : sys.rhs();
-  std::string to_target = "-";
+  int to_target = -1;
   int k = 0;
   KrylovMonitor mon;
   mon.record_history = true;
   mon.velocity_error = [&](const Vector &x) {
     const Vector dv = form == Form::body ? x : body_from_lambda(sys, ex, x);
     const double ve = (dv - dv_ref).norm();
-    if (to_target == "-" && ve / dv_ref.norm() <= kTarget) to_target = std::to_string(k);
+    if (to_target < 0 && ve / dv_ref.norm() <= kTarget) to_target = k;
     ++k;
     return ve;
   };
@@ -603,33 +695,33 @@ std::string library_to_target(const ContactSystem &sys, Form form, const LinearO
   return to_target;
 }
 
-}  // namespace
+} // namespace
 
 // tests/data/material350_step1000.sys: written by `fix fibre_contact ... export 200 snap` in
 // examples/material/in.material at N = 350, step 1000 (the deck of commit dc68075: emitter at
 // z 6-14, mu_roll 0.1): 341 bodies, 489 contacts (235 on the floor), compliances of the fix's
-// auto rule. A fixed test input: later deck versions need not reproduce it. fibre_analyze's summary
-// and histories on it, both forms, every method and preconditioner and two --combine entries,
-// against the same runs through the library with an independent sparse-Cholesky dv*.
+// auto rule. A fixed test input: later deck versions need not reproduce it. The analysis on it,
+// both forms, every method and preconditioner and two combinations, against the same runs
+// through the library with an independent sparse-Cholesky dv*.
 TEST(FibreAnalyze, ExportedMaterialSystemMatchesTheLibrary)
 {
-  const std::string file = FIBRE_TEST_DATA_DIR "/material350_step1000.sys";
-  const ContactSystem sys = read_system_file(file);
+  const ContactSystem sys = read_system_file(FIBRE_TEST_DATA_DIR "/material350_step1000.sys");
   ASSERT_EQ(sys.num_bodies(), 341);
   ASSERT_EQ(sys.num_owned_bodies(), 341);
   ASSERT_EQ(sys.num_contacts(), 489);
-  ScratchDir dir("fibre_analyze_export");
   constexpr int kMaxiter = 120;
-  const ToolResult res =
-      run_tool({file, "--maxiter", std::to_string(kMaxiter), "--csv",
-                (dir.path / "hist.csv").string(), "--combine", "add_fibre_tree,mul_tree_fibre"},
-               dir.path);
-  ASSERT_EQ(res.status, 0) << res.out << res.err;
-  const auto summary = parse_summary(res.out);
-  EXPECT_EQ(summary.size(), 2u * (15u + 6u)) << res.out;
+  AnalysisOptions opt;
+  opt.maxiter = kMaxiter;
+  opt.combinations = {Combination::add_fibre_tree, Combination::mul_tree_fibre};
+  const AnalysisSystem in = prepare_system(sys);
+  const Analysis an = analyze(in.system, opt);
+  const auto runs = runs_by_key(an);
+  EXPECT_EQ(runs.size(), 2u * (15u + 6u));
+  std::stringstream csv_text;
+  write_history_csv(csv_text, an, "material350_step1000.sys", 1.0);
   std::string header;
   std::map<std::string, long> sizes;
-  const auto csv = read_history(dir.path / "hist.csv", header, sizes);
+  const auto csv = read_history(csv_text, header, sizes);
   EXPECT_EQ(sizes["contact"], 6L * 489);
   EXPECT_EQ(sizes["body"], 6L * 341);
 
@@ -638,19 +730,16 @@ TEST(FibreAnalyze, ExportedMaterialSystemMatchesTheLibrary)
   const Vector dv_ref = llt.solve(body_rhs(sys, serial_exchange(), sys.rhs()));
   const double floor = 1e-11 * dv_ref.norm();
   for (Form form : {Form::contact, Form::body}) {
-    const double norm_A =
-        form == Form::body ? assemble_K(sys).norm() : assemble_A(sys).norm();
+    const double norm_A = form == Form::body ? assemble_K(sys).norm() : assemble_A(sys).norm();
     for (PrecondKind kind : kPreconds)
       for (Method m : kMethods) {
         const Key k = key(form, kind, m);
         SCOPED_TRACE(k);
-        ASSERT_TRUE(summary.count(k)) << res.out;
+        ASSERT_TRUE(runs.count(k));
         ASSERT_TRUE(csv.count(k));
         const LibraryRun lib = library_run(sys, form, kind, m, kMaxiter, dv_ref, norm_A);
-        const SummaryRow &row = summary.at(k);
-        EXPECT_EQ(row.iterations, lib.result.iterations);
-        EXPECT_EQ(row.stop, to_string(lib.result.reason));
-        EXPECT_EQ(row.to_target, lib.to_target);
+        const fibre::Run &run = *runs.at(k);
+        expect_same_run(run, lib);
         const std::vector<CsvRow> &hist = csv.at(k);
         ASSERT_EQ(hist.size(), lib.rows.size());
         const std::size_t at = std::min<std::size_t>(100, hist.size() - 1);
@@ -660,11 +749,11 @@ TEST(FibreAnalyze, ExportedMaterialSystemMatchesTheLibrary)
       }
     // the body form converges on this export (Table "iterations to 1e-6" of RESULTS.md)
     if (form == Form::body) {
-      const SummaryRow &tree = summary.at(key(form, PrecondKind::tree, Method::cg));
-      ASSERT_NE(tree.to_target, "-");
-      EXPECT_LE(std::stoi(tree.to_target), 40);
+      const int tree = iterations_to(*runs.at(key(form, PrecondKind::tree, Method::cg)), kTarget);
+      ASSERT_GE(tree, 0);
+      EXPECT_LE(tree, 40);
     }
-    // --combine against the test's own combinations of the library's preconditioners
+    // the combinations against the test's own combinations of the library's preconditioners
     const Exchange &ex = serial_exchange();
     const auto A = make_operator(form, sys, ex);
     auto build = [&](PrecondKind kind) {
@@ -674,12 +763,13 @@ TEST(FibreAnalyze, ExportedMaterialSystemMatchesTheLibrary)
     };
     const TestAverage avg(build(PrecondKind::fibre), build(PrecondKind::tree));
     const TestSymmetricProduct prod(*A, build(PrecondKind::tree), build(PrecondKind::fibre));
-    const std::string f = to_string(form);
-    ASSERT_TRUE(summary.count(f + "/add_fibre_tree/cg")) << res.out;
-    ASSERT_TRUE(summary.count(f + "/mul_tree_fibre/cg")) << res.out;
-    EXPECT_EQ(summary.at(f + "/add_fibre_tree/cg").to_target,
+    const Key add = key(form, "add_fibre_tree", Method::cg);
+    const Key mul = key(form, "mul_tree_fibre", Method::cg);
+    ASSERT_TRUE(runs.count(add));
+    ASSERT_TRUE(runs.count(mul));
+    EXPECT_EQ(iterations_to(*runs.at(add), kTarget),
               library_to_target(sys, form, *A, avg, kMaxiter, dv_ref));
-    EXPECT_EQ(summary.at(f + "/mul_tree_fibre/cg").to_target,
+    EXPECT_EQ(iterations_to(*runs.at(mul), kTarget),
               library_to_target(sys, form, *A, prod, kMaxiter, dv_ref));
   }
 }

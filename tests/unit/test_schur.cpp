@@ -5,6 +5,7 @@
 #include "fibre/kernels.hpp"
 #include "fibre/operators.hpp"
 #include "fibre/scenes.hpp"
+#include "fibre/spook.hpp"
 #include "reference.hpp"
 
 using namespace fibre;

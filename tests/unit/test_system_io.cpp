@@ -10,6 +10,7 @@
 
 #include "fibre/spook.hpp"
 #include "fibre/scenes.hpp"
+#include "fibre/spook.hpp"
 #include "fibre/system_io.hpp"
 #include "reference.hpp"
 

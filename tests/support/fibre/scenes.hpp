@@ -1,6 +1,7 @@
 // Synthetic contact systems for tests, benchmarks and reports: the thesis's 3x3 grid and
-// polydisperse piles made by ballistic deposition. Real scenes come from the LAMMPS decks
-// in examples/ through `fix fibre_contact export`.
+// polydisperse piles made by ballistic deposition. Test support (library fibre_scenes), not
+// part of fibre_solver. Real scenes come from the LAMMPS decks in examples/ through
+// `fix fibre_contact export`.
 #pragma once
 
 #include <cstdint>
@@ -14,9 +15,9 @@ namespace fibre {
 struct SceneParams {
   int rows = 6;
   SpookParams spook{};
-  double compliance = 1e-8;          // eps on every row
-  double contact_tolerance = 0.05;   // pairs with gap < tolerance * mean radius are contacts
-  double max_overlap = 0.01;         // random overlap added to gaps, times the mean radius
+  double compliance = 1e-8;        // eps on every row
+  double contact_tolerance = 0.05; // pairs with gap < tolerance * mean radius are contacts
+  double max_overlap = 0.01;       // random overlap added to gaps, times the mean radius
   std::uint64_t seed = 1;
 };
 
@@ -52,4 +53,4 @@ std::vector<Body> read_sphere_dump(const std::string &path, double gravity = 9.8
 // floor and four side walls.
 ContactSystem lammps_pile_scene(const std::string &dump_path, const SceneParams &p);
 
-}  // namespace fibre
+} // namespace fibre

@@ -28,8 +28,7 @@ void randomize_motion(std::vector<Body> &bodies, std::mt19937_64 &rng)
   }
 }
 
-ContactSystem finish(std::vector<Body> bodies, std::vector<Contact> contacts,
-                     const SceneParams &p)
+ContactSystem finish(std::vector<Body> bodies, std::vector<Contact> contacts, const SceneParams &p)
 {
   set_compliance(contacts, p.compliance);
   ContactSystem sys(std::move(bodies), std::move(contacts), p.rows, p.spook);
@@ -37,7 +36,7 @@ ContactSystem finish(std::vector<Body> bodies, std::vector<Contact> contacts,
   return sys;
 }
 
-}  // namespace
+} // namespace
 
 ContactSystem grid_scene(const SceneParams &p)
 {
@@ -74,10 +73,10 @@ ContactSystem pile_scene(int n, const SceneParams &p)
   for (int i = 0; i < n; ++i) {
     Body b;
     b.radius = rmin + (rmax - rmin) * uni(rng);
-    b.mass = b.radius * b.radius * b.radius;  // unit density up to 4 pi / 3
+    b.mass = b.radius * b.radius * b.radius; // unit density up to 4 pi / 3
     const double x = b.radius + (side - 2 * b.radius) * uni(rng);
     const double y = b.radius + (side - 2 * b.radius) * uni(rng);
-    double z = b.radius;  // resting on the floor
+    double z = b.radius; // resting on the floor
     for (const Body &o : bodies) {
       const double dx = x - o.x.x(), dy = y - o.x.y(), reach = b.radius + o.radius;
       const double d2 = dx * dx + dy * dy;
@@ -187,8 +186,8 @@ ContactSystem packing_scene(std::vector<Body> bodies, const std::vector<Plane> &
           if (x < 0 || y < 0 || z < 0 || x >= dims[0] || y >= dims[1] || z >= dims[2]) continue;
           for (int j : cells[flat(x, y, z)]) {
             if (j <= i) continue;
-            const double gap = (bodies[i].x - bodies[j].x).norm() - bodies[i].radius -
-                bodies[j].radius;
+            const double gap =
+                (bodies[i].x - bodies[j].x).norm() - bodies[i].radius - bodies[j].radius;
             if (gap >= tol) continue;
             const bool i_up = bodies[i].x.z() >= bodies[j].x.z();
             contacts.push_back(sphere_sphere_contact(bodies, i_up ? i : j, i_up ? j : i));
@@ -220,7 +219,8 @@ std::vector<Body> read_sphere_dump(const std::string &path, double gravity)
     }
   const std::vector<std::string> need = {"id", "radius", "mass", "x", "y", "z", "vx", "vy", "vz"};
   if (columns.size() < need.size() || !std::equal(need.begin(), need.end(), columns.begin()))
-    throw std::runtime_error("sphere dump '" + path + "' needs columns: id radius mass x y z vx vy vz");
+    throw std::runtime_error("sphere dump '" + path +
+                             "' needs columns: id radius mass x y z vx vy vz");
   const bool has_omega = columns.size() >= 12 && columns[9] == "omegax";
   std::vector<Body> bodies;
   while (std::getline(in, line)) {
@@ -246,12 +246,14 @@ std::vector<Body> read_sphere_dump(const std::string &path, double gravity)
 
 ContactSystem lammps_pile_scene(const std::string &dump_path, const SceneParams &p)
 {
-  const std::vector<Plane> walls = {{Vec3::UnitZ(), 0.0},   {Vec3::UnitX(), 0.0},
-                                    {-Vec3::UnitX(), -8.0}, {Vec3::UnitY(), 0.0},
+  const std::vector<Plane> walls = {{Vec3::UnitZ(), 0.0},
+                                    {Vec3::UnitX(), 0.0},
+                                    {-Vec3::UnitX(), -8.0},
+                                    {Vec3::UnitY(), 0.0},
                                     {-Vec3::UnitY(), -8.0}};
   SceneParams q = p;
-  q.contact_tolerance = 0.0;  // the Hertz overlaps themselves
+  q.contact_tolerance = 0.0; // the Hertz overlaps themselves
   return packing_scene(read_sphere_dump(dump_path), walls, q);
 }
 
-}  // namespace fibre
+} // namespace fibre
