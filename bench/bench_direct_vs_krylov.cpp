@@ -119,7 +119,7 @@ struct Row {
   double seconds = NAN;
   int iterations = -1;
   double ve = NAN;
-  double setup = NAN;  // preconditioner / factorization share, where separable
+  double setup = NAN; // preconditioner / factorization share, where separable
 };
 
 void print_rows(const std::vector<Row> &rows, double mumps_body, double mumps_contact)
@@ -136,9 +136,8 @@ void print_rows(const std::vector<Row> &rows, double mumps_body, double mumps_co
     }
     char setup[16] = "-";
     if (!std::isnan(r.setup)) std::snprintf(setup, sizeof setup, "%.3f", 1e3 * r.setup);
-    std::printf("  %-30s %10.3f %9s %6s %9.2e %11.1fx %13.1fx\n", r.name.c_str(),
-                1e3 * r.seconds, setup, iters, r.ve, mumps_body / r.seconds,
-                mumps_contact / r.seconds);
+    std::printf("  %-30s %10.3f %9s %6s %9.2e %11.1fx %13.1fx\n", r.name.c_str(), 1e3 * r.seconds,
+                setup, iters, r.ve, mumps_body / r.seconds, mumps_contact / r.seconds);
   }
 }
 
@@ -199,7 +198,7 @@ Row krylov_row(const ContactSystem &sys, const Reference &ref, Form form, Precon
   row.seconds = median(total);
   row.setup = median(setup);
   // The body form's velocities are its iterate (lambda_from_body amplifies the error by
-  // 1 / Sigma, design.md section 7); the contact form's are M^-1 G^T lambda.
+  // 1 / Sigma, doc/design.md section 7); the contact form's are M^-1 G^T lambda.
   row.ve = ve_rel(ref, dv);
   return row;
 }
@@ -212,7 +211,8 @@ Row mumps_row(const ContactSystem &sys, const Reference &ref, Form form, int rep
   Row row;
   row.name = std::string("MUMPS ") + (form == Form::body ? "K (body)" : "A (contact)");
   Vector lambda;
-  row.seconds = timed(repeat, [&] { lambda = direct_solve(form, sys, ex, sys.rhs(), MPI_COMM_SELF); });
+  row.seconds =
+      timed(repeat, [&] { lambda = direct_solve(form, sys, ex, sys.rhs(), MPI_COMM_SELF); });
   row.ve = ve_rel(ref, body_from_lambda(sys, ex, lambda));
   return row;
 }
@@ -285,7 +285,7 @@ void run_case(const std::string &name, const ContactSystem &sys, int repeat, boo
   for (Form form : {Form::body, Form::contact})
     for (PrecondKind kind : {PrecondKind::tree, PrecondKind::fibre, PrecondKind::block})
       for (Method m : methods) {
-        // The contact form stalls above the target on stiff systems (design.md section 7):
+        // The contact form stalls above the target on stiff systems (doc/design.md section 7):
         // give it room, but not forever.
         const int max_iter = form == Form::body ? 3000 : 1500;
         rows.push_back(krylov_row(sys, ref, form, kind, m, repeat, max_iter));
@@ -305,7 +305,7 @@ void run_case(const std::string &name, const ContactSystem &sys, int repeat, boo
   std::fflush(stdout);
 }
 
-}  // namespace
+} // namespace
 
 int main(int argc, char **argv)
 {
@@ -316,11 +316,16 @@ int main(int argc, char **argv)
   std::vector<std::string> files;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
-    if (a == "--repeat" && i + 1 < argc) repeat = std::atoi(argv[++i]);
-    else if (a == "--heap" && i + 1 < argc) heaps.push_back(std::atoi(argv[++i]));
-    else if (a == "--sys" && i + 1 < argc) files.push_back(argv[++i]);
-    else if (a == "--no-default") defaults = false;
-    else if (a == "--cg-only") all_methods = false;
+    if (a == "--repeat" && i + 1 < argc)
+      repeat = std::atoi(argv[++i]);
+    else if (a == "--heap" && i + 1 < argc)
+      heaps.push_back(std::atoi(argv[++i]));
+    else if (a == "--sys" && i + 1 < argc)
+      files.push_back(argv[++i]);
+    else if (a == "--no-default")
+      defaults = false;
+    else if (a == "--cg-only")
+      all_methods = false;
     else {
       std::fprintf(stderr,
                    "usage: %s [--repeat R] [--heap N]... [--sys FILE]... [--no-default] "
@@ -352,8 +357,8 @@ int main(int argc, char **argv)
     if (defaults) {
       const std::string dump = std::string(FIBRE_BENCH_DATA_DIR) + "/pile400.dump";
       if (std::ifstream(dump).good())
-        run_case("LAMMPS pile400 (tests/data, SceneParams defaults)", lammps_pile_scene(dump, SceneParams{}),
-                 repeat, all_methods);
+        run_case("LAMMPS pile400 (tests/data, SceneParams defaults)",
+                 lammps_pile_scene(dump, SceneParams{}), repeat, all_methods);
     }
 #endif
     for (const std::string &f : files) run_case(f, read_system_file(f), repeat, all_methods);

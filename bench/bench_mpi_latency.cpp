@@ -25,7 +25,8 @@ int main(int argc, char **argv)
   for (int round = 0; round < 5; ++round) {
     MPI_Barrier(MPI_COMM_WORLD);
     double x = 1.0, t0 = MPI_Wtime();
-    for (int i = 0; i < reps; ++i) MPI_Allreduce(MPI_IN_PLACE, &x, 1, MPI_DOUBLE, MPI_SUM, MPI_COMM_WORLD);
+    for (int i = 0; i < reps; ++i)
+      MPI_Allreduce(MPI_IN_PLACE, &x, 1, MPI_DOUBLE, MPI_SUM, MPI_COMM_WORLD);
     t_all.push_back((MPI_Wtime() - t0) / reps);
     MPI_Barrier(MPI_COMM_WORLD);
     t0 = MPI_Wtime();

@@ -1,6 +1,6 @@
 // Preconditioner build (fibres or forest + factorization) and apply against the number of
 // contacts, 1e3 .. 1e6, on heap_scene (bench_scenes.hpp: dense heap, ~3 contacts per body,
-// material parameters), next to the Schur product of the same form in the same run. design.md
+// material parameters), next to the Schur product of the same form in the same run. doc/design.md
 // section 3 asks for O(contacts) to build and to apply: the `per_contact` counter stays flat.
 //
 // Targets (issue #7): linear growth (flat ns per contact); under 2 ms at 15,000 contacts (the

@@ -23,11 +23,16 @@ namespace {
 
 bool parse_build(const std::string &what, Form &form, PrecondKind &kind)
 {
-  if (what == "contact_fibre") form = Form::contact, kind = PrecondKind::fibre;
-  else if (what == "contact_tree") form = Form::contact, kind = PrecondKind::tree;
-  else if (what == "body_fibre") form = Form::body, kind = PrecondKind::fibre;
-  else if (what == "body_tree") form = Form::body, kind = PrecondKind::tree;
-  else return false;
+  if (what == "contact_fibre")
+    form = Form::contact, kind = PrecondKind::fibre;
+  else if (what == "contact_tree")
+    form = Form::contact, kind = PrecondKind::tree;
+  else if (what == "body_fibre")
+    form = Form::body, kind = PrecondKind::fibre;
+  else if (what == "body_tree")
+    form = Form::body, kind = PrecondKind::tree;
+  else
+    return false;
   return true;
 }
 
@@ -89,7 +94,7 @@ __attribute__((noinline)) double run_target(const std::string &what, const Conta
   return sink;
 }
 
-}  // namespace
+} // namespace
 
 int main(int argc, char **argv)
 {

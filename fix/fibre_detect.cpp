@@ -31,7 +31,8 @@ void LammpsDetection::init_walls(const std::vector<fibre::WallSpec> &walls)
     const std::string &id = walls[w].region_id;
     regions_[w] = domain->find_region(id);
     if (regions_[w] < 0)
-      error->all(FLERR, "Region ID '" + id + "' for fix fibre_contact 'wall region' does not exist");
+      error->all(FLERR,
+                 "Region ID '" + id + "' for fix fibre_contact 'wall region' does not exist");
     if (domain->regions[regions_[w]]->dynamic)
       error->all(FLERR, "Fix fibre_contact does not support moving region '" + id +
                             "' (walls must be at rest)");
@@ -96,8 +97,8 @@ std::vector<fibre::Body> LammpsDetection::bodies()
   return out;
 }
 
-std::vector<fibre::DetectedContact> LammpsDetection::contacts(
-    const std::vector<fibre::Body> &bodies, double h, double damping) const
+std::vector<fibre::DetectedContact>
+LammpsDetection::contacts(const std::vector<fibre::Body> &bodies, double h, double damping) const
 {
   std::vector<fibre::DetectedContact> found;
   pair_contacts(bodies, h, damping, found);
@@ -119,7 +120,7 @@ void LammpsDetection::pair_contacts(const std::vector<fibre::Body> &bodies, doub
   double **x = atom->x;
   const double *radius = atom->radius;
   const bool newton_pair = force->newton_pair != 0;
-  const double reach = neighbor->skin;  // pairs beyond radsum + skin are not in the list
+  const double reach = neighbor->skin; // pairs beyond radsum + skin are not in the list
 
   for (int ii = 0; ii < list->inum; ++ii) {
     const int i = list->ilist[ii];
@@ -128,7 +129,7 @@ void LammpsDetection::pair_contacts(const std::vector<fibre::Body> &bodies, doub
       const int j = jlist[jj] & NEIGHMASK;
       const int bi = atom_body_[i], bj = atom_body_[j];
       if (bi < 0 && bj < 0) continue;
-      if (tag[i] == tag[j]) continue;  // a periodic image of itself
+      if (tag[i] == tag[j]) continue; // a periodic image of itself
       if (j >= nlocal && !newton_pair && tag[i] > tag[j]) continue;
       const double dx = x[i][0] - x[j][0], dy = x[i][1] - x[j][1], dz = x[i][2] - x[j][2];
       const double rsq = dx * dx + dy * dy + dz * dz;
@@ -203,8 +204,8 @@ void LammpsDetection::wall_contacts(const std::vector<fibre::Body> &bodies, doub
     region->prematch();
     for (int k = 0; k < nowned; ++k) {
       const fibre::Body &b = bodies[k];
-      const int nc = region->surface(b.x[0], b.x[1], b.x[2],
-                                     fibre::region_cutoff(b, h, damping, skin));
+      const int nc =
+          region->surface(b.x[0], b.x[1], b.x[2], fibre::region_cutoff(b, h, damping, skin));
       for (int c = 0; c < nc; ++c) {
         const Region::Contact &rc = region->contact[c];
         if (!(rc.r > 0.0)) continue;
@@ -216,4 +217,4 @@ void LammpsDetection::wall_contacts(const std::vector<fibre::Body> &bodies, doub
   }
 }
 
-}  // namespace fibre_lmp
+} // namespace fibre_lmp

@@ -39,8 +39,8 @@ class LammpsDetection : protected LAMMPS_NS::Pointers {
   int groupbit_;
   LammpsExchange &exchange_;
   std::vector<fibre::WallSpec> walls_;
-  std::vector<int> regions_;  // per wall: region index, or -1
-  std::vector<int> atom_body_;  // local atom -> body index, -1 if not a body
+  std::vector<int> regions_;   // per wall: region index, or -1
+  std::vector<int> atom_body_; // local atom -> body index, -1 if not a body
 };
 
-}  // namespace fibre_lmp
+} // namespace fibre_lmp

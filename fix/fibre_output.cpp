@@ -62,16 +62,16 @@ void FibreOutput::report_solve(const fibre::StepResult &res)
     const bigint step = update->ntimestep;
     if (last_warning_step_ < 0 || step - last_warning_step_ >= 100) {
       if (comm->me == 0)
-        error->warning(FLERR, "Fix fibre_contact: contact solve did not converge at step " +
-                                  std::to_string(static_cast<long long>(step)) + " (" +
-                                  fibre::to_string(res.reason) + ", " +
-                                  std::to_string(res.iterations) + " iterations, relative "
-                                  "residual " + fibre::format_g(res.rel_residual) + "); " +
-                                  std::to_string(static_cast<long long>(
-                                      nonconverged_since_warning_)) +
-                                  " non-converged steps since the last warning, " +
-                                  std::to_string(static_cast<long long>(nonconverged_total_)) +
-                                  " in all");
+        error->warning(FLERR,
+                       "Fix fibre_contact: contact solve did not converge at step " +
+                           std::to_string(static_cast<long long>(step)) + " (" +
+                           fibre::to_string(res.reason) + ", " + std::to_string(res.iterations) +
+                           " iterations, relative "
+                           "residual " +
+                           fibre::format_g(res.rel_residual) + "); " +
+                           std::to_string(static_cast<long long>(nonconverged_since_warning_)) +
+                           " non-converged steps since the last warning, " +
+                           std::to_string(static_cast<long long>(nonconverged_total_)) + " in all");
       last_warning_step_ = step;
       nonconverged_since_warning_ = 0;
     }
@@ -120,8 +120,8 @@ void FibreOutput::export_step(const std::string &prefix, const fibre::ContactSys
   try {
     fibre::write_system_file(base + ".sys", sys);
   } catch (std::exception &e) {
-    error->one(FLERR, "Fix fibre_contact could not write export file " + base + ".sys: " +
-                          e.what());
+    error->one(FLERR,
+               "Fix fibre_contact could not write export file " + base + ".sys: " + e.what());
   }
   FILE *fp = std::fopen((base + ".lambda").c_str(), "w");
   if (!fp) error->one(FLERR, "Fix fibre_contact could not write export file " + base + ".lambda");
@@ -171,4 +171,4 @@ double FibreOutput::memory_bytes() const
   return double(maxlocal_) * kLocalColumns * sizeof(double);
 }
 
-}  // namespace fibre_lmp
+} // namespace fibre_lmp

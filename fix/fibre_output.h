@@ -14,15 +14,28 @@ namespace fibre_lmp {
 // Entries of the global vector (f_ID[k + 1]); the doc page's "Restart, fix_modify, output"
 // lists them.
 enum Stat {
-  V_ITER = 0, V_RESID, V_CONTACTS, V_FIBRES, V_FIBRE_FRACTION, V_PASSES, V_OVERLAP, V_SETUP,
-  V_SOLVE, V_CONVERGED, V_WALL_CONTACTS, V_NONCONVERGED, V_COMPLEMENTARITY, V_SWEEPS,
-  V_SWEEP_TIME, V_SIZE
+  V_ITER = 0,
+  V_RESID,
+  V_CONTACTS,
+  V_FIBRES,
+  V_FIBRE_FRACTION,
+  V_PASSES,
+  V_OVERLAP,
+  V_SETUP,
+  V_SOLVE,
+  V_CONVERGED,
+  V_WALL_CONTACTS,
+  V_NONCONVERGED,
+  V_COMPLEMENTARITY,
+  V_SWEEPS,
+  V_SWEEP_TIME,
+  V_SIZE
 };
 
 class FibreOutput : protected LAMMPS_NS::Pointers {
  public:
   static constexpr int kLocalColumns = 8;
-  static constexpr double kRestartFormat = 2.0;  // 2: 15 global values
+  static constexpr double kRestartFormat = 2.0; // 2: 15 global values
 
   explicit FibreOutput(LAMMPS_NS::LAMMPS *lmp) : Pointers(lmp) {}
   ~FibreOutput() override;
@@ -55,4 +68,4 @@ class FibreOutput : protected LAMMPS_NS::Pointers {
   double **local_array_ = nullptr;
 };
 
-}  // namespace fibre_lmp
+} // namespace fibre_lmp

@@ -152,8 +152,7 @@ void FixFibreContact::init()
   dtv_ = update->dt;
   detection_->init_walls(settings_.walls);
   warn_double_integration();
-  if (comm->me == 0)
-    utils::logmesg(lmp, "fix fibre_contact: " + fibre::describe(settings_) + "\n");
+  if (comm->me == 0) utils::logmesg(lmp, "fix fibre_contact: " + fibre::describe(settings_) + "\n");
 }
 
 /* ---------------------------------------------------------------------- */
@@ -193,8 +192,7 @@ void FixFibreContact::check_finite(const char *what, double **array, int nvalues
     for (int d = 0; d < nvalues; ++d)
       if (!std::isfinite(array[i][d]))
         error->one(FLERR, std::string("Fix fibre_contact: non-finite ") + what + " of atom " +
-                              std::to_string(static_cast<long long>(atom->tag[i])) +
-                              " at step " +
+                              std::to_string(static_cast<long long>(atom->tag[i])) + " at step " +
                               std::to_string(static_cast<long long>(update->ntimestep)));
   }
 }
@@ -302,10 +300,10 @@ void FixFibreContact::final_integrate()
   overflow_count_ += history_.store(found, res.lambda, model.rows, dtv_, atom->nlocal);
 
   // report
-  output_->fill_local(found, any ? &res.lambda : nullptr, model.rows, array_local,
-                      size_local_rows);
+  output_->fill_local(found, any ? &res.lambda : nullptr, model.rows, array_local, size_local_rows);
   output_->report_solve(res);
-  if (do_export) output_->export_step(settings_.export_prefix, sys, found, any ? &res.lambda : nullptr);
+  if (do_export)
+    output_->export_step(settings_.export_prefix, sys, found, any ? &res.lambda : nullptr);
   if (overflow_count_ > 0 && !overflow_warned_ && comm->me == 0) {
     error->warning(FLERR, "Fix fibre_contact: more than " +
                               std::to_string(fibre::ContactHistory::kMaxSlots) +

@@ -16,7 +16,7 @@ namespace fibre_lmp {
 class LammpsExchange;
 class LammpsDetection;
 class FibreOutput;
-}  // namespace fibre_lmp
+} // namespace fibre_lmp
 
 namespace LAMMPS_NS {
 
@@ -64,7 +64,7 @@ class FixFibreContact : public Fix {
   fibre::Settings settings_;
   double dtv_ = 0.0;
   double m_min_ = 0.0;
-  class Pair *pair_ = nullptr;  // pair style whose force computation this fix switched off
+  class Pair *pair_ = nullptr; // pair style whose force computation this fix switched off
   std::unique_ptr<fibre_lmp::LammpsExchange> exchange_;
   std::unique_ptr<fibre_lmp::LammpsDetection> detection_;
   std::unique_ptr<fibre_lmp::FibreOutput> output_;
@@ -73,6 +73,6 @@ class FixFibreContact : public Fix {
   bool overflow_warned_ = false;
 };
 
-}  // namespace LAMMPS_NS
+} // namespace LAMMPS_NS
 
 #endif

@@ -19,9 +19,9 @@ inline auto make_args_checked(const S &, const Args &...args)
 {
   return fmt::make_format_args(args...);
 }
-}  // namespace fmt
+} // namespace fmt
 
-#define FIBRE_LAMMPS_COMM_FIX_API 1  // 2021 API: forward_comm_fix / reverse_comm_fix
+#define FIBRE_LAMMPS_COMM_FIX_API 1 // 2021 API: forward_comm_fix / reverse_comm_fix
 #define fibre_forward_comm(comm, fix, n) (comm)->forward_comm_fix((fix), (n))
 #define fibre_reverse_comm(comm, fix, n) (comm)->reverse_comm_fix((fix), (n))
 #endif

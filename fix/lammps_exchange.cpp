@@ -78,7 +78,7 @@ long LammpsExchange::exclusive_prefix_sum(long local) const
   MPI_Exscan(&local, &result, 1, MPI_LONG, MPI_SUM, world_);
   int rank = 0;
   MPI_Comm_rank(world_, &rank);
-  return rank == 0 ? 0 : result;  // MPI_Exscan leaves rank 0's result undefined
+  return rank == 0 ? 0 : result; // MPI_Exscan leaves rank 0's result undefined
 }
 
 int LammpsExchange::pack_forward(int n, const int *list, double *buf) const
@@ -120,4 +120,4 @@ void LammpsExchange::unpack_reverse(int n, const int *list, const double *buf) c
   }
 }
 
-}  // namespace fibre_lmp
+} // namespace fibre_lmp

@@ -16,7 +16,7 @@
 namespace LAMMPS_NS {
 class LAMMPS;
 class Fix;
-}  // namespace LAMMPS_NS
+} // namespace LAMMPS_NS
 
 namespace fibre_lmp {
 
@@ -53,7 +53,7 @@ class LammpsExchange final : public fibre::Exchange {
   MPI_Comm world_;
   std::vector<int> body_atom_;
   int num_owned_ = 0;
-  mutable std::vector<double> halo_;  // 6 per local atom (owned + ghost)
+  mutable std::vector<double> halo_; // 6 per local atom (owned + ghost)
 };
 
-}  // namespace fibre_lmp
+} // namespace fibre_lmp

@@ -21,7 +21,7 @@ template <typename T> Fix *fix_creator(LAMMPS *lmp, int narg, char **arg)
 {
   return new T(lmp, narg, arg);
 }
-}  // namespace
+} // namespace
 
 int main(int argc, char **argv)
 {
@@ -29,7 +29,8 @@ int main(int argc, char **argv)
   {
     LAMMPS lmp(argc, argv, MPI_COMM_WORLD);
     (*lmp.modify->fix_map)["fibre_contact"] = &fix_creator<FixFibreContact>;
-    utils::logmesg(&lmp, std::string("fibre_contact add-on ") + FIBRE_VERSION +
+    utils::logmesg(&lmp,
+                   std::string("fibre_contact add-on ") + FIBRE_VERSION +
                        ": fix fibre_contact (nonsmooth contact dynamics, fibre preconditioner)\n");
     lmp.input->file();
   }

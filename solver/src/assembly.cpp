@@ -18,8 +18,7 @@ SparseMatrix assemble_G(const ContactSystem &sys)
       for (int r = 0; r < rows; ++r)
         for (int j = 0; j < kBodyDofs; ++j)
           if (J(r, j) != 0.0)
-            t.emplace_back(Eigen::Index(rows) * c + r, Eigen::Index(kBodyDofs) * body + j,
-                           J(r, j));
+            t.emplace_back(Eigen::Index(rows) * c + r, Eigen::Index(kBodyDofs) * body + j, J(r, j));
     }
   }
   SparseMatrix G(sys.contact_dofs(), sys.body_dofs());
@@ -97,4 +96,4 @@ void upper_triplets(const SparseMatrix &S, std::vector<long> &rows, std::vector<
       }
 }
 
-}  // namespace fibre
+} // namespace fibre

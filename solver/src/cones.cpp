@@ -20,7 +20,7 @@ Cones::Cones(const ContactSystem &sys, const FrictionParams &friction)
 // Hot in the sweeps: squared norms, one square root only for a cone outside.
 void Cones::project(double *l, int c) const
 {
-  l[0] = l[0] > 0 ? l[0] : 0.0;  // also NaN -> 0
+  l[0] = l[0] > 0 ? l[0] : 0.0; // also NaN -> 0
   if (!std::isfinite(l[0])) l[0] = 0.0;
   for (int k = 0; k < num_cones(rows_); ++k) {
     double *t = l + kCones[k].first;
@@ -74,4 +74,4 @@ double complementarity(const ContactSystem &sys, const Exchange &ex, const Cones
   return std::sqrt(sums[0] / sums[1]);
 }
 
-}  // namespace fibre
+} // namespace fibre

@@ -28,8 +28,8 @@ int ContactHistory::pack(int i, double *buf) const
 
 int ContactHistory::unpack(int i, const double *buf, int available)
 {
-  const int n = std::min({kMaxSlots, std::max(0, static_cast<int>(buf[0])),
-                          std::max(0, available) / kSlotSize});
+  const int n = std::min(
+      {kMaxSlots, std::max(0, static_cast<int>(buf[0])), std::max(0, available) / kSlotSize});
   count_[i] = n;
   std::copy(buf + 1, buf + 1 + n * kSlotSize, &slots_[std::size_t(i) * kMaxSlots * kSlotSize]);
   return 1 + n * kSlotSize;
@@ -74,7 +74,7 @@ long ContactHistory::store(const std::vector<DetectedContact> &found, const Vect
     const DetectedContact &fc = found[c];
     const Contact &k = fc.contact;
     const double *l = lambda.data() + Eigen::Index(rows) * c;
-    if (!(l[0] > 0.0)) continue;  // released: nothing to remember
+    if (!(l[0] > 0.0)) continue; // released: nothing to remember
     const Vec3 force = (l[0] * k.normal + l[1] * k.t1 + l[2] * k.t2) / h;
     Vec3 moment = Vec3::Zero();
     if (rows == 6) moment = (l[3] * k.normal + l[4] * k.t1 + l[5] * k.t2) / h;
@@ -93,4 +93,4 @@ long ContactHistory::store(const std::vector<DetectedContact> &found, const Vect
   return overflow;
 }
 
-}  // namespace fibre
+} // namespace fibre

@@ -28,4 +28,4 @@ void set_compliance(const ComplianceParams &p, double h, double m_min,
   }
 }
 
-}  // namespace fibre
+} // namespace fibre

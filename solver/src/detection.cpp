@@ -4,8 +4,7 @@
 
 namespace fibre {
 
-bool is_contact(const Body &a, const Body *b, const Vec3 &n, double gap, double h,
-                double damping)
+bool is_contact(const Body &a, const Body *b, const Vec3 &n, double gap, double h, double damping)
 {
   const double rmin = b ? std::min(a.radius, b->radius) : a.radius;
   const double margin = kContactMargin * rmin;
@@ -52,4 +51,4 @@ void sort_contacts(std::vector<DetectedContact> &found)
   });
 }
 
-}  // namespace fibre
+} // namespace fibre

@@ -17,22 +17,42 @@ namespace fibre {
 namespace {
 
 // MUMPS documents its parameters 1-based: ICNTL(k) is icntl[k - 1].
-constexpr int k(int one_based) { return one_based - 1; }
+constexpr int k(int one_based)
+{
+  return one_based - 1;
+}
 
 std::string infog_meaning(int code)
 {
   switch (code) {
-    case -1: return "error on another process";
-    case -2: return "number of entries out of range";
-    case -3: return "invalid JOB (solve before factorization?)";
-    case -5: case -7: case -13: return "out of memory";
-    case -6: return "structurally singular matrix";
-    case -8: case -9: case -14: case -15: return "internal workspace too small";
-    case -10: return "numerically singular matrix (not positive definite)";
-    case -16: return "matrix order out of range";
-    case -20: case -22: return "invalid input array";
-    case -21: return "invalid PAR for the number of processes";
-    default: return "see the MUMPS users' guide";
+  case -1:
+    return "error on another process";
+  case -2:
+    return "number of entries out of range";
+  case -3:
+    return "invalid JOB (solve before factorization?)";
+  case -5:
+  case -7:
+  case -13:
+    return "out of memory";
+  case -6:
+    return "structurally singular matrix";
+  case -8:
+  case -9:
+  case -14:
+  case -15:
+    return "internal workspace too small";
+  case -10:
+    return "numerically singular matrix (not positive definite)";
+  case -16:
+    return "matrix order out of range";
+  case -20:
+  case -22:
+    return "invalid input array";
+  case -21:
+    return "invalid PAR for the number of processes";
+  default:
+    return "see the MUMPS users' guide";
   }
 }
 
@@ -96,7 +116,7 @@ std::vector<T> route(MPI_Comm comm, int nprocs, const std::vector<T> &items,
   return received;
 }
 
-}  // namespace
+} // namespace
 
 struct DistributedCholesky::Impl {
   MPI_Comm comm = MPI_COMM_NULL;
@@ -112,18 +132,18 @@ struct DistributedCholesky::Impl {
     dmumps_c(&id);
     const int info1 = id.infog[k(1)], info2 = id.infog[k(2)];
     if (info1 < 0)
-      throw DirectSolverError("MUMPS " + std::string(stage) + " failed: INFOG(1) = " +
-                                  std::to_string(info1) + " (" + infog_meaning(info1) +
-                                  "), INFOG(2) = " + std::to_string(info2),
+      throw DirectSolverError("MUMPS " + std::string(stage) +
+                                  " failed: INFOG(1) = " + std::to_string(info1) + " (" +
+                                  infog_meaning(info1) + "), INFOG(2) = " + std::to_string(info2),
                               info1, info2);
   }
 
   void silence()
   {
-    id.icntl[k(1)] = -1;  // error messages
-    id.icntl[k(2)] = -1;  // diagnostics and warnings
-    id.icntl[k(3)] = -1;  // global information
-    id.icntl[k(4)] = 0;   // print level
+    id.icntl[k(1)] = -1; // error messages
+    id.icntl[k(2)] = -1; // diagnostics and warnings
+    id.icntl[k(3)] = -1; // global information
+    id.icntl[k(4)] = 0;  // print level
   }
 };
 
@@ -134,8 +154,8 @@ DistributedCholesky::DistributedCholesky(MPI_Comm comm) : impl_(std::make_unique
   MPI_Comm_rank(impl_->comm, &impl_->rank);
   MPI_Comm_size(impl_->comm, &impl_->nprocs);
   impl_->id.comm_fortran = static_cast<MUMPS_INT>(MPI_Comm_c2f(impl_->comm));
-  impl_->id.par = 1;  // the host works too
-  impl_->id.sym = 1;  // symmetric positive definite: Cholesky without pivoting
+  impl_->id.par = 1; // the host works too
+  impl_->id.sym = 1; // symmetric positive definite: Cholesky without pivoting
   try {
     impl_->call(-1, "initialisation");
   } catch (...) {
@@ -166,8 +186,7 @@ void DistributedCholesky::factorize(long n, const std::vector<long> &rows,
                    "triplet arrays differ in length");
   bool ok = true;
   for (std::size_t e = 0; e < rows.size() && ok; ++e)
-    ok = rows[e] >= 0 && rows[e] < n && cols[e] >= 0 && cols[e] < n &&
-        std::isfinite(values[e]);
+    ok = rows[e] >= 0 && rows[e] < n && cols[e] >= 0 && cols[e] < n && std::isfinite(values[e]);
   collective_check(m.comm, ok, "matrix entry with index out of range or non-finite value");
   n_ = n;
   if (n == 0) {
@@ -187,8 +206,8 @@ void DistributedCholesky::factorize(long n, const std::vector<long> &rows,
   }
   m.silence();
   m.id.n = static_cast<MUMPS_INT>(n);
-  m.id.icntl[k(5)] = 0;   // assembled format
-  m.id.icntl[k(18)] = 3;  // distributed entries, analysis and factorization on each rank's own
+  m.id.icntl[k(5)] = 0;  // assembled format
+  m.id.icntl[k(18)] = 3; // distributed entries, analysis and factorization on each rank's own
   m.id.nnz_loc = static_cast<MUMPS_INT8>(nz);
   m.id.nz_loc = 0;
   m.id.irn_loc = m.irn.data();
@@ -294,12 +313,11 @@ Vector solve_contact_form(const ContactSystem &sys, const Vector &b, MPI_Comm co
   return Eigen::Map<const Vector>(x.data(), static_cast<Eigen::Index>(x.size()));
 }
 
-Vector solve_body_form(const ContactSystem &sys, const Exchange &ex, const Vector &b,
-                       MPI_Comm comm)
+Vector solve_body_form(const ContactSystem &sys, const Exchange &ex, const Vector &b, MPI_Comm comm)
 {
   long total = 0;
-  const std::vector<long> body = global_body_index(ex, sys.num_owned_bodies(),
-                                                   sys.num_bodies(), total);
+  const std::vector<long> body =
+      global_body_index(ex, sys.num_owned_bodies(), sys.num_bodies(), total);
   auto global = [&](Eigen::Index local) {
     return body[local / kBodyDofs] * kBodyDofs + local % kBodyDofs;
   };
@@ -339,7 +357,7 @@ Vector solve_body_form(const ContactSystem &sys, const Exchange &ex, const Vecto
   return lambda_from_body(sys, ex, b, dv);
 }
 
-}  // namespace
+} // namespace
 
 Vector direct_solve(Form form, const ContactSystem &sys, const Exchange &ex, const Vector &b,
                     MPI_Comm comm)
@@ -381,4 +399,4 @@ Vector refined_body_solution(const ContactSystem &sys, double *refinement)
   return dv;
 }
 
-}  // namespace fibre
+} // namespace fibre

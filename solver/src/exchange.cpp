@@ -2,8 +2,7 @@
 
 namespace fibre {
 
-std::vector<long> global_body_index(const Exchange &ex, int num_owned, int num_bodies,
-                                    long &total)
+std::vector<long> global_body_index(const Exchange &ex, int num_owned, int num_bodies, long &total)
 {
   const long offset = ex.exclusive_prefix_sum(num_owned);
   total = static_cast<long>(ex.sum(static_cast<double>(num_owned)));
@@ -22,4 +21,4 @@ const Exchange &serial_exchange()
   return ex;
 }
 
-}  // namespace fibre
+} // namespace fibre

@@ -70,7 +70,7 @@ class WalkWeight {
       break;
     }
     const double pn = prev.squaredNorm();
-    if (pn == 0) return 0.0;  // first edge of a fibre: no preference
+    if (pn == 0) return 0.0; // first edge of a fibre: no preference
     const Vec3 e(y[0] - x[0], y[1] - x[1], y[2] - x[2]);
     const double norms = std::sqrt(e.squaredNorm() * pn);
     return norms > 0 ? 1.0 - std::abs(e.dot(prev)) / norms : 1.0;
@@ -93,7 +93,7 @@ class WalkWeight {
   std::vector<double> pos_;
 };
 
-}  // namespace
+} // namespace
 
 double edge_weight(const ContactSystem &sys, EdgeWeight weight, const Vector *impulses, int c,
                    int from, const Vec3 &prev_dir)
@@ -175,7 +175,7 @@ Fibres greedy_fibres(const ContactSystem &sys, const ContactGraph &g, const Walk
   return f;
 }
 
-}  // namespace
+} // namespace
 
 Fibres build_fibres(const ContactSystem &sys, EdgeWeight weight, const Vector *impulses,
                     bool include_ghosts)
@@ -205,7 +205,7 @@ struct DisjointSets {
   }
 };
 
-}  // namespace
+} // namespace
 
 Forest build_forest(const ContactSystem &sys, EdgeWeight weight, const Vector *impulses,
                     bool include_ghosts)
@@ -254,7 +254,7 @@ Forest build_forest(const ContactSystem &sys, EdgeWeight weight, const Vector *i
   f.stats.num_contacts = g.num_edges;
   f.stats.contacts_in_fibres = f.num_edges;
   std::vector<char> seen(nb, 0);
-  std::vector<std::pair<int, int>> stack;  // (body, next adjacency position)
+  std::vector<std::pair<int, int>> stack; // (body, next adjacency position)
   for (int root = 0; root < limit; ++root) {
     if (seen[root]) continue;
     seen[root] = 1;
@@ -285,4 +285,4 @@ Forest build_forest(const ContactSystem &sys, EdgeWeight weight, const Vector *i
   return f;
 }
 
-}  // namespace fibre
+} // namespace fibre

@@ -12,7 +12,7 @@ inline void row_weights(const ContactSystem &sys, int c, double *wt)
     wt[r] = (r < sys.rows() && sys.row_active(base + r)) ? 1.0 : 0.0;
 }
 
-}  // namespace
+} // namespace
 
 // ---- The products (the Krylov methods' inner loop) ----
 //
@@ -34,8 +34,8 @@ namespace {
 #endif
 
 template <int R>
-FIBRE_INLINE void contact_velocity(const double *D, const double *ra, const double *rb, const double *wa,
-                             const double *wb, double *u)
+FIBRE_INLINE void contact_velocity(const double *D, const double *ra, const double *rb,
+                                   const double *wa, const double *wb, double *u)
 {
   // t = v_a + omega_a x ra (- v_b - omega_b x rb), o = omega_a (- omega_b)
   double t0 = wa[0] + wa[4] * ra[2] - wa[5] * ra[1];
@@ -57,14 +57,13 @@ FIBRE_INLINE void contact_velocity(const double *D, const double *ra, const doub
 
 // Adds G_c^T l into the body vectors ya and (if not a wall) yb.
 template <int R>
-FIBRE_INLINE void contact_impulse(const double *D, const double *ra, const double *rb, const double *l,
-                            double *ya, double *yb)
+FIBRE_INLINE void contact_impulse(const double *D, const double *ra, const double *rb,
+                                  const double *l, double *ya, double *yb)
 {
   double f[3], m[3] = {0, 0, 0};
   for (int k = 0; k < 3; ++k) f[k] = D[3 * k] * l[0] + D[3 * k + 1] * l[1] + D[3 * k + 2] * l[2];
   if (R == 6)
-    for (int k = 0; k < 3; ++k)
-      m[k] = D[3 * k] * l[3] + D[3 * k + 1] * l[4] + D[3 * k + 2] * l[5];
+    for (int k = 0; k < 3; ++k) m[k] = D[3 * k] * l[3] + D[3 * k + 1] * l[4] + D[3 * k + 2] * l[5];
   ya[0] += f[0];
   ya[1] += f[1];
   ya[2] += f[2];
@@ -80,12 +79,11 @@ FIBRE_INLINE void contact_impulse(const double *D, const double *ra, const doubl
   yb[5] -= rb[0] * f[1] - rb[1] * f[0] + m[2];
 }
 
-constexpr int kAhead = 16;  // prefetch distance in contacts
+constexpr int kAhead = 16; // prefetch distance in contacts
 
 // The bodies are gathered and scattered by index: ask for those of contact c + kAhead now (the
 // contact arrays themselves stream and need no help). rw: 1 when they will be written.
-template <int RW>
-inline void prefetch_bodies(const int *pairs, int c, int nc, const double *v)
+template <int RW> inline void prefetch_bodies(const int *pairs, int c, int nc, const double *v)
 {
 #if defined(__GNUC__)
   if (c + kAhead >= nc) return;
@@ -174,7 +172,7 @@ FIBRE_INLINE void gtg_kernel(const ContactSystem &sys, const double *w, double *
     contact_velocity<R>(q, q + 9, q + 12, w + 6 * std::size_t(a), wb, u);
     for (int r = 0; r < R; ++r) {
       const std::size_t row = std::size_t(R) * c + r;
-      u[r] *= Masked ? wt[row] * inv_sigma[row] : inv_sigma[row];  // weights are 0 or 1
+      u[r] *= Masked ? wt[row] * inv_sigma[row] : inv_sigma[row]; // weights are 0 or 1
     }
     contact_impulse<R>(q, q + 9, q + 12, u, out + 6 * std::size_t(a),
                        b >= 0 ? out + 6 * std::size_t(b) : nullptr);
@@ -186,11 +184,15 @@ void dispatch(const ContactSystem &sys, Args... args)
 {
   const bool masked = sys.row_weight().size() > 0;
   if (sys.rows() == 6) {
-    if (masked) F<6, true>::run(sys, args...);
-    else F<6, false>::run(sys, args...);
+    if (masked)
+      F<6, true>::run(sys, args...);
+    else
+      F<6, false>::run(sys, args...);
   } else {
-    if (masked) F<3, true>::run(sys, args...);
-    else F<3, false>::run(sys, args...);
+    if (masked)
+      F<3, true>::run(sys, args...);
+    else
+      F<3, false>::run(sys, args...);
   }
 }
 
@@ -207,7 +209,7 @@ template <int R, bool M> struct GtgRun {
   static void run(const ContactSystem &s, const double *w, double *o) { gtg_kernel<R, M>(s, w, o); }
 };
 
-}  // namespace
+} // namespace
 
 void g_apply(const ContactSystem &sys, const Vector &w, Vector &out)
 {
@@ -258,7 +260,7 @@ inline Eigen::Matrix<double, 6, 1> body_inv_mass(const ContactSystem &sys, int b
 {
   return sys.inv_mass().segment<6>(6 * body);
 }
-}  // namespace
+} // namespace
 
 Mat6 diagonal_block(const ContactSystem &sys, int c)
 {
@@ -291,7 +293,7 @@ Mat6 coupling_block(const ContactSystem &sys, int c, int d)
     for (int sd = 0; sd < 2; ++sd)
       if (bc[sc] >= 0 && bc[sc] == bd[sd])
         C += jacobian_block(sys, c, sc) * body_inv_mass(sys, bc[sc]).asDiagonal() *
-            jacobian_block(sys, d, sd).transpose();
+             jacobian_block(sys, d, sd).transpose();
   return C;
 }
 
@@ -302,7 +304,7 @@ inline Eigen::Matrix<double, 6, 1> inv_sigma_rows(const ContactSystem &sys, int 
   for (int r = 0; r < sys.rows(); ++r) s[r] = 1.0 / sys.sigma()[Eigen::Index(sys.rows()) * c + r];
   return s;
 }
-}  // namespace
+} // namespace
 
 std::vector<Mat6> body_diagonal_blocks(const ContactSystem &sys)
 {
@@ -326,7 +328,7 @@ Mat6 body_coupling_block(const ContactSystem &sys, int c)
 {
   if (sys.contacts()[c].is_wall()) return Mat6::Zero();
   return jacobian_block(sys, c, 0).transpose() * inv_sigma_rows(sys, c).asDiagonal() *
-      jacobian_block(sys, c, 1);
+         jacobian_block(sys, c, 1);
 }
 
-}  // namespace fibre
+} // namespace fibre

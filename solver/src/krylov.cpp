@@ -51,8 +51,7 @@ class Session {
   // Bookkeeping after iteration k (k = 0: the initial or restart residual, which is true).
   // r_norm: ||r|| of the (updated) residual; rPr: r^T P^-1 r as the method knows it;
   // trust_rPr: rPr is an estimate that may trigger the true-residual check (MINRES).
-  Next step(int k, const Vector &x, double r_norm, double rPr, bool is_true,
-            bool trust_rPr = false)
+  Next step(int k, const Vector &x, double r_norm, double rPr, bool is_true, bool trust_rPr = false)
   {
     result_.iterations = k;
     have_true_ = is_true && have_true_;
@@ -83,7 +82,7 @@ class Session {
       return Next::restart;
     }
     // Checked after convergence: at round-off level r^T P^-1 r is noise of either sign.
-    if (rPr < 0) return stop_now(StopReason::breakdown);  // P is not positive definite
+    if (rPr < 0) return stop_now(StopReason::breakdown); // P is not positive definite
     if (k >= stop_.max_iter) return stop_now(StopReason::max_iterations);
     return Next::iterate;
   }
@@ -154,26 +153,26 @@ class Session {
   const Vector &b_;
   const StopControl &stop_;
   const KrylovMonitor *monitor_;
-  Vector x0_;                // finite fallback should x ever turn non-finite
-  Vector r_true_;            // b - A x when have_true_
-  bool have_true_ = false;   // r_true_ belongs to the current x
-  bool true_valid_ = false;  // true_norm_ belongs to the current x
+  Vector x0_;               // finite fallback should x ever turn non-finite
+  Vector r_true_;           // b - A x when have_true_
+  bool have_true_ = false;  // r_true_ belongs to the current x
+  bool true_valid_ = false; // true_norm_ belongs to the current x
   bool stopped_ = false;
   double b_norm_ = 0, b_norm_P_ = 0, true_norm_ = 0;
   double last_check_norm_ = std::numeric_limits<double>::infinity();
-  int stalled_checks_ = 0;  // failed checks in a row without the true residual halving
+  int stalled_checks_ = 0; // failed checks in a row without the true residual halving
   static constexpr int kLevelOff = 10;
   double best_rel_ = std::numeric_limits<double>::infinity();
   int best_k_ = 0;
   SolveResult result_;
 };
 
-}  // namespace
+} // namespace
 
 // Preconditioned CG on the Schur complement (thesis Algorithm 3, Uzawa with conjugate
 // directions). rPr = r^T z with z = P^-1 r.
 SolveResult cg(const LinearOperator &A, const Preconditioner &P, const Vector &b, Vector &x,
-                  const StopControl &stop, const KrylovMonitor *monitor)
+               const StopControl &stop, const KrylovMonitor *monitor)
 {
   Session s(A, P, b, x, stop, monitor);
   Vector r, z, p, Ap;
@@ -342,14 +341,18 @@ SolveResult krylov_solve(Method m, const LinearOperator &A, const Preconditioner
                          const KrylovMonitor *monitor)
 {
   switch (m) {
-    case Method::cg: return cg(A, P, b, x, stop, monitor);
-    case Method::cr: return conjugate_residual(A, P, b, x, stop, monitor);
-    case Method::minres: return minres(A, P, b, x, stop, monitor);
-    case Method::direct:
-    case Method::pgs: break;
+  case Method::cg:
+    return cg(A, P, b, x, stop, monitor);
+  case Method::cr:
+    return conjugate_residual(A, P, b, x, stop, monitor);
+  case Method::minres:
+    return minres(A, P, b, x, stop, monitor);
+  case Method::direct:
+  case Method::pgs:
+    break;
   }
   throw std::invalid_argument(std::string("krylov_solve: ") + to_string(m) +
                               " is not a Krylov method");
 }
 
-}  // namespace fibre
+} // namespace fibre

@@ -60,7 +60,7 @@ void zero_ghosts(const ContactSystem &sys, Vector &v)
   const Eigen::Index owned = Eigen::Index(kBodyDofs) * sys.num_owned_bodies();
   v.tail(v.size() - owned).setZero();
 }
-}  // namespace
+} // namespace
 
 Vector body_rhs(const ContactSystem &sys, const Exchange &ex, const Vector &b)
 {
@@ -96,4 +96,4 @@ std::unique_ptr<LinearOperator> make_operator(Form form, const ContactSystem &sy
   return std::make_unique<BodySpaceOperator>(sys, ex);
 }
 
-}  // namespace fibre
+} // namespace fibre

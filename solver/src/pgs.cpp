@@ -18,14 +18,14 @@ PgsResult pgs(const ContactSystem &sys, const Exchange &ex, const Cones &cones, 
   const Vector &inv_mass = sys.inv_mass();
   const Vector &sigma = sys.sigma();
   Vector dv = velocity_change(sys, ex, lambda);
-  Vector dv_start, moved, lambda_start;  // reused by every sweep
+  Vector dv_start, moved, lambda_start; // reused by every sweep
   double best = INFINITY;
   int since_best = 0;
   for (int s = 0; s < control.max_sweeps; ++s) {
     // dv follows this process's updates; `moved` collects them for the other processes.
     dv_start = dv;
     lambda_start = lambda;
-    double norms[2] = {0, 0};  // ||change||^2, ||lambda||^2
+    double norms[2] = {0, 0}; // ||change||^2, ||lambda||^2
     for (int c = 0; c < nc; ++c) {
       const Contact &k = sys.contacts()[c];
       const Eigen::Index at = Eigen::Index(rows) * c, ia = 6 * Eigen::Index(k.a),
@@ -74,4 +74,4 @@ PgsResult pgs(const ContactSystem &sys, const Exchange &ex, const Cones &cones, 
   return res;
 }
 
-}  // namespace fibre
+} // namespace fibre

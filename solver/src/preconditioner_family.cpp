@@ -19,7 +19,7 @@ namespace {
 using RowMat6 = Eigen::Matrix<double, 6, 6, Eigen::RowMajor>;
 
 constexpr int kB = 6;
-constexpr int kPacked = 21;  // lower triangle of a 6x6 block
+constexpr int kPacked = 21; // lower triangle of a 6x6 block
 constexpr int kBlock = 36;
 
 // Packed lower triangle, column by column: (i, j), i >= j.
@@ -37,7 +37,7 @@ inline void ldlt6(double *a)
   double delta[kB];
   FIBRE_UNROLL
   for (int j = 0; j < kB; ++j) {
-    double t[kB];  // L_jk Delta_k
+    double t[kB]; // L_jk Delta_k
     double d = a[at(j, j)];
     FIBRE_UNROLL
     for (int k = 0; k < j; ++k) {
@@ -124,7 +124,7 @@ class Storage {
     static constexpr std::size_t kKeep = 4;
     std::vector<std::pair<std::size_t, std::unique_ptr<double[]>>> kept;
     ~Pool() { closed() = true; }
-    static bool &closed()  // trivially destructible: still readable while statics die
+    static bool &closed() // trivially destructible: still readable while statics die
     {
       thread_local bool flag = false;
       return flag;
@@ -141,7 +141,7 @@ class Storage {
     if (!data_) return;
     Pool *pool = Pool::get();
     if (!pool) return;
-    if (pool->kept.size() == Pool::kKeep) {  // keep the largest arrays
+    if (pool->kept.size() == Pool::kKeep) { // keep the largest arrays
       std::size_t smallest = 0;
       for (std::size_t i = 1; i < pool->kept.size(); ++i)
         if (pool->kept[i].first < pool->kept[smallest].first) smallest = i;
@@ -303,10 +303,10 @@ class ForestFactor {
   int dim_;
   std::vector<int> parent_;
   std::vector<int> offset_;
-  std::vector<int> wslot_;  // position in w_, -1 for roots
+  std::vector<int> wslot_; // position in w_, -1 for roots
   std::vector<signed char> sign_;
-  Storage l_;  // 21 per node: sign D, then its L Delta L^T factor
-  Storage w_;  // 36 per node with a parent: B, then V = L^-1 B
+  Storage l_; // 21 per node: sign D, then its L Delta L^T factor
+  Storage w_; // 36 per node with a parent: B, then V = L^-1 B
 };
 
 class ForestPreconditioner final : public Preconditioner {
@@ -330,7 +330,7 @@ class ForestPreconditioner final : public Preconditioner {
   std::string name_;
   ForestFactor factor_;
   Eigen::Index size_;
-  bool covers_all_;  // every entry belongs to a node (false: ghost bodies, left zero)
+  bool covers_all_; // every entry belongs to a node (false: ghost bodies, left zero)
   mutable std::vector<double> work_;
 };
 
@@ -422,7 +422,7 @@ class BlockBuilder {
   }
   int body(int c, int side) const
   {
-    return pairs_[2 * std::size_t(c) + side];  // b = -1 for walls
+    return pairs_[2 * std::size_t(c) + side]; // b = -1 for walls
   }
   // Contact loops run in contact order, but bodies are scattered: ask for the inverse masses
   // of the contact kPrefetch ahead (c may be past the end) and, if given, of another contact.
@@ -622,7 +622,7 @@ class BlockBuilder {
   // One side's J^T Sigma^-1 J into K, with X = P_t [r]x.
   static void world_side(const M3 &Pt, const M3 &Pr, const Vec3 &r, M3 &X, M3 &SX, Mat6 &K)
   {
-    for (int i = 0; i < 3; ++i) {  // X = P_t [r]x, row by row
+    for (int i = 0; i < 3; ++i) { // X = P_t [r]x, row by row
       X[i][0] = Pt[i][1] * r[2] - Pt[i][2] * r[1];
       X[i][1] = Pt[i][2] * r[0] - Pt[i][0] * r[2];
       X[i][2] = Pt[i][0] * r[1] - Pt[i][1] * r[0];
@@ -638,9 +638,9 @@ class BlockBuilder {
   }
 
   const ContactSystem &sys_;
-  const int *pairs_;  // body pairs, 2 per contact (flat: 8 bytes a contact)
+  const int *pairs_; // body pairs, 2 per contact (flat: 8 bytes a contact)
   int rows_;
-  bool plain_;  // six rows and no mask: the weights are all one
+  bool plain_; // six rows and no mask: the weights are all one
 };
 
 // ---- contact form ----
@@ -716,7 +716,7 @@ std::unique_ptr<Preconditioner> contact_tree(const ContactSystem &sys, const Pre
   if (stats) *stats = forest.stats;
   const BlockBuilder blocks(sys);
   const int nb = sys.num_bodies(), nc = sys.num_contacts(), rows = sys.rows();
-  const int *pairs = sys.body_pairs();  // a, b per contact; b = -1 for walls
+  const int *pairs = sys.body_pairs(); // a, b per contact; b = -1 for walls
   auto body_a = [&](int c) { return pairs[2 * std::size_t(c)]; };
   auto body_b = [&](int c) { return pairs[2 * std::size_t(c) + 1]; };
 
@@ -762,7 +762,7 @@ std::unique_ptr<Preconditioner> contact_tree(const ContactSystem &sys, const Pre
                contact_node[c] < tree_nodes ? body_node[parent_body(c)] : -1, 1);
   f.link();
   const Vector &inv_mass = sys.inv_mass();
-  for (int i = 0; i < nb; ++i) {  // body i: -M_i, stored as M_i; -G^T to its parent contact
+  for (int i = 0; i < nb; ++i) { // body i: -M_i, stored as M_i; -G^T to its parent contact
     if (body_node[i] < 0) continue;
     const int pc = forest.parent_contact[i];
     f.set_diag(body_node[i], Vec6(inv_mass.segment<6>(6 * i).cwiseInverse()));
@@ -818,7 +818,7 @@ void body_blocks(const ContactSystem &sys, const Exchange &ex, const std::vector
   };
   for (int c = 0; c < sys.num_contacts(); ++c) {
 #if defined(__GNUC__)
-    if (c + BlockBuilder::kPrefetch < sys.num_contacts()) {  // scattered bodies: see prefetch()
+    if (c + BlockBuilder::kPrefetch < sys.num_contacts()) { // scattered bodies: see prefetch()
       const std::size_t ahead = 2 * std::size_t(c + BlockBuilder::kPrefetch);
       __builtin_prefetch(packed(pairs[ahead]));
       if (pairs[ahead + 1] >= 0) __builtin_prefetch(packed(pairs[ahead + 1]));
@@ -915,7 +915,7 @@ std::unique_ptr<Preconditioner> body_tree(const ContactSystem &sys, const Exchan
   return body_forest("tree", sys, ex, link, node);
 }
 
-}  // namespace
+} // namespace
 
 std::unique_ptr<Preconditioner> make_preconditioner(Form form, const ContactSystem &sys,
                                                     const Exchange &ex, const PrecondOptions &opt,
@@ -953,6 +953,6 @@ std::unique_ptr<Preconditioner> make_preconditioner(Form form, const ContactSyst
   throw std::invalid_argument("unknown preconditioner");
 }
 
-}  // namespace fibre
+} // namespace fibre
 
 #undef FIBRE_UNROLL

@@ -44,8 +44,7 @@ class Reader {
     return value;
   }
 
-  template <class E>
-  E name(std::size_t i, const std::string &key) const
+  template <class E> E name(std::size_t i, const std::string &key) const
   {
     const std::string expected = "'" + key + " " + choices<E>() + "'";
     if (!has(i)) illegal(expected);
@@ -93,12 +92,18 @@ std::size_t read_wall(const Reader &in, std::size_t i, WallSpec &w)
 std::size_t read_solver_keyword(const Reader &in, std::size_t i, StepOptions &opt)
 {
   const std::string &key = in.at(i);
-  if (key == "form") opt.form = in.name<Form>(i + 1, key);
-  else if (key == "solver") opt.solver = in.name<Method>(i + 1, key);
-  else if (key == "precond") opt.precond.kind = in.name<PrecondKind>(i + 1, key);
-  else if (key == "weight") opt.precond.weight = in.name<EdgeWeight>(i + 1, key);
-  else if (key == "tol") opt.stop.tol = in.positive(i + 1, "'tol <positive number>'");
-  else if (key == "pass_tol") opt.pass_tol = in.positive(i + 1, "'pass_tol <positive number>'");
+  if (key == "form")
+    opt.form = in.name<Form>(i + 1, key);
+  else if (key == "solver")
+    opt.solver = in.name<Method>(i + 1, key);
+  else if (key == "precond")
+    opt.precond.kind = in.name<PrecondKind>(i + 1, key);
+  else if (key == "weight")
+    opt.precond.weight = in.name<EdgeWeight>(i + 1, key);
+  else if (key == "tol")
+    opt.stop.tol = in.positive(i + 1, "'tol <positive number>'");
+  else if (key == "pass_tol")
+    opt.pass_tol = in.positive(i + 1, "'pass_tol <positive number>'");
   else if (key == "maxiter")
     opt.stop.max_iter =
         static_cast<int>(in.integer(i + 1, "'maxiter <positive integer>'", 1, 100000000));
@@ -106,10 +111,11 @@ std::size_t read_solver_keyword(const Reader &in, std::size_t i, StepOptions &op
     opt.active_set_max =
         static_cast<int>(in.integer(i + 1, "'active_set <positive integer>'", 1, 1000));
   else if (key == "sweeps")
-    opt.sweeps =
-        static_cast<int>(in.integer(i + 1, "'sweeps <non-negative integer>'", 0, 100000));
-  else if (key == "sweep_tol") opt.sweep_tol = in.positive(i + 1, "'sweep_tol <positive number>'");
-  else return 0;
+    opt.sweeps = static_cast<int>(in.integer(i + 1, "'sweeps <non-negative integer>'", 0, 100000));
+  else if (key == "sweep_tol")
+    opt.sweep_tol = in.positive(i + 1, "'sweep_tol <positive number>'");
+  else
+    return 0;
   return 2;
 }
 
@@ -154,7 +160,7 @@ std::size_t read_model_keyword(const Reader &in, std::size_t i, Settings &s)
   return 0;
 }
 
-}  // namespace
+} // namespace
 
 Settings parse_settings(const std::vector<std::string> &args)
 {
@@ -195,9 +201,11 @@ std::string describe(const Settings &s)
   const ComplianceParams &c = s.model.compliance;
   std::string out = describe(s.step) + ", rows " + std::to_string(s.model.rows) + ", damping " +
                     format_g(s.model.damping) + ", compliance ";
-  if (c.automatic) out += "auto (" + format_g(c.factor) + " dt^2 / m_min)";
-  else out += format_g(c.eps_n) + " " + format_g(c.eps_t);
+  if (c.automatic)
+    out += "auto (" + format_g(c.factor) + " dt^2 / m_min)";
+  else
+    out += format_g(c.eps_n) + " " + format_g(c.eps_t);
   return out;
 }
 
-}  // namespace fibre
+} // namespace fibre

@@ -119,8 +119,7 @@ void shifted_tridiagonal_solve(const std::vector<double> &a, const std::vector<d
   }
   x[n - 1] /= d[n - 1];
   if (n > 1) x[n - 2] = (x[n - 2] - du[n - 2] * x[n - 1]) / d[n - 2];
-  for (int i = n - 3; i >= 0; --i)
-    x[i] = (x[i] - du[i] * x[i + 1] - du2[i] * x[i + 2]) / d[i];
+  for (int i = n - 3; i >= 0; --i) x[i] = (x[i] - du[i] * x[i + 1] - du2[i] * x[i + 2]) / d[i];
 }
 
 // |last component| of the unit eigenvector of T for the eigenvalue theta (inverse iteration).
@@ -134,7 +133,7 @@ double last_component(const std::vector<double> &a, const std::vector<double> &b
     double norm = 0;
     for (double v : x) norm += v * v;
     norm = std::sqrt(norm);
-    if (!(norm > 0) || !std::isfinite(norm)) return 1.0;  // give up: counts as unconverged
+    if (!(norm > 0) || !std::isfinite(norm)) return 1.0; // give up: counts as unconverged
     for (double &v : x) v /= norm;
   }
   return std::abs(x[n - 1]);
@@ -158,8 +157,7 @@ Spectrum ritz_check(const std::vector<double> &alpha, const std::vector<double> 
   const double tiny = std::max(scale, 1e-300) * 1e-15;
   // Rounding can leave Ritz values of an SPD pencil at or below zero: they end the list.
   const int positive = static_cast<int>(
-      std::find_if(theta.begin(), theta.end(), [](double x) { return !(x > 0); }) -
-      theta.begin());
+      std::find_if(theta.begin(), theta.end(), [](double x) { return !(x > 0); }) - theta.begin());
   if (positive == 0) throw std::runtime_error("lanczos_spectrum: no positive Ritz value");
   Spectrum s = effective_condition(std::vector<double>(theta.begin(), theta.begin() + positive));
   // Residuals only where the decision needs them (each costs O(m)); the rest stay infinite.
@@ -172,8 +170,8 @@ Spectrum ritz_check(const std::vector<double> &alpha, const std::vector<double> 
   auto settled = [&](int i) { return residual(i) <= opt.gap_tol * theta[i]; };
   const double slack = (1 + opt.gap_tol) * (1 + opt.gap_tol);
   // The values kappa_e is made of.
-  const bool ok = positive == m && residual(0) <= opt.tol * theta[0] &&
-      residual(s.r) <= opt.tol * theta[s.r];
+  const bool ok =
+      positive == m && residual(0) <= opt.tol * theta[0] && residual(s.r) <= opt.tol * theta[s.r];
   bool certified = ok && (s.r + 1 == m || (settled(s.r + 1) && settled(m - 1)));
   // Certified: no unresolved stretch can hide a larger ratio. Below lambda_r every Ritz value
   // is settled, or the gap beats the whole span below it; above it likewise, with the span
@@ -182,15 +180,19 @@ Spectrum ritz_check(const std::vector<double> &alpha, const std::vector<double> 
   if (certified && s.r + 1 < m) {
     bool below = s.gap_ratio >= slack * theta[s.r + 1] / theta[m - 1];
     for (int i = m - 1; i > s.r && !below; --i)
-      if (!settled(i)) break;
-      else if (i == s.r + 1) below = true;
+      if (!settled(i))
+        break;
+      else if (i == s.r + 1)
+        below = true;
     certified = below;
   }
   if (certified && s.r > 1) {
     bool above = s.gap_ratio >= slack * s.kappa_e;
     for (int i = 1; i < s.r && !above; ++i)
-      if (!settled(i)) break;
-      else if (i == s.r - 1) above = true;
+      if (!settled(i))
+        break;
+      else if (i == s.r - 1)
+        above = true;
     certified = above;
   }
   if (is_certified) *is_certified = certified;
@@ -200,7 +202,7 @@ Spectrum ritz_check(const std::vector<double> &alpha, const std::vector<double> 
   return s;
 }
 
-}  // namespace
+} // namespace
 
 Spectrum lanczos_spectrum(const LinearOperator &A, const Preconditioner &P,
                           const LanczosOptions &opt)
@@ -280,9 +282,8 @@ Spectrum lanczos_spectrum(Form form, const ContactSystem &sys, const Exchange &e
   std::mt19937_64 rng(opt.seed);
   std::uniform_real_distribution<double> u(-1.0, 1.0);
   Vector start = Vector::Zero(op->size());
-  const Eigen::Index live = form == Form::body
-      ? Eigen::Index(kBodyDofs) * sys.num_owned_bodies()
-      : op->size();
+  const Eigen::Index live =
+      form == Form::body ? Eigen::Index(kBodyDofs) * sys.num_owned_bodies() : op->size();
   for (Eigen::Index i = 0; i < live; ++i) start[i] = u(rng);
   LanczosOptions o = opt;
   o.start = &start;
@@ -312,4 +313,4 @@ Spectrum body_space_spectrum(const ContactSystem &sys)
   return effective_condition(std::move(mu));
 }
 
-}  // namespace fibre
+} // namespace fibre

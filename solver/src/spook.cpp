@@ -35,7 +35,7 @@ Vector spook_rhs(const ContactSystem &sys, const Vector *extra_dv)
   g_apply(sys, w, b);
   b = -b;
   for (int c = 0; c < sys.num_contacts(); ++c) {
-    const Eigen::Index row = Eigen::Index(sys.rows()) * c;  // normal row
+    const Eigen::Index row = Eigen::Index(sys.rows()) * c; // normal row
     if (sys.row_active(row)) b[row] -= 4.0 / p.h * ups * sys.contacts()[c].gap;
   }
   return b;
@@ -51,4 +51,4 @@ Vector velocity_change(const ContactSystem &sys, const Exchange &ex, const Vecto
   return dv;
 }
 
-}  // namespace fibre
+} // namespace fibre

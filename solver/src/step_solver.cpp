@@ -16,12 +16,12 @@ std::string describe(const StepOptions &opt)
 {
   const auto g = format_g;
   return std::string("form ") + to_string(opt.form) + ", solver " + to_string(opt.solver) +
-         ", precond " + to_string(opt.precond.kind) + ", weight " +
-         to_string(opt.precond.weight) + ", tol " + g(opt.stop.tol) + ", pass_tol " +
-         g(opt.pass_tol) + ", maxiter " + std::to_string(opt.stop.max_iter) + ", mu " +
-         g(opt.friction.mu) + ", mu_roll " + g(opt.friction.mu_roll) + ", mu_twist " +
-         g(opt.friction.mu_twist) + ", active_set " + std::to_string(opt.active_set_max) +
-         ", sweeps " + std::to_string(opt.sweeps) + ", sweep_tol " + g(opt.sweep_tol);
+         ", precond " + to_string(opt.precond.kind) + ", weight " + to_string(opt.precond.weight) +
+         ", tol " + g(opt.stop.tol) + ", pass_tol " + g(opt.pass_tol) + ", maxiter " +
+         std::to_string(opt.stop.max_iter) + ", mu " + g(opt.friction.mu) + ", mu_roll " +
+         g(opt.friction.mu_roll) + ", mu_twist " + g(opt.friction.mu_twist) + ", active_set " +
+         std::to_string(opt.active_set_max) + ", sweeps " + std::to_string(opt.sweeps) +
+         ", sweep_tol " + g(opt.sweep_tol);
 }
 
 namespace {
@@ -36,16 +36,15 @@ struct ContactState {
   bool capped[3] = {false, false, false};
   int uncaps[3] = {0, 0, 0};
   Eigen::Vector2d dir[3] = {Eigen::Vector2d::Zero(), Eigen::Vector2d::Zero(),
-                           Eigen::Vector2d::Zero()};
+                            Eigen::Vector2d::Zero()};
 };
 
 // The active-set loop of doc/design.md section 2 around one linear solver, then the sweeps.
 class StepSolver {
  public:
   StepSolver(ContactSystem &sys, const Exchange &ex, const StepOptions &opt, MPI_Comm comm)
-      : sys_(sys), ex_(ex), opt_(opt), comm_(comm), rows_(sys.rows()),
-        nc_(sys.num_contacts()), cones_(sys, opt.friction), state_(nc_),
-        all_rows_(sys.contact_dofs(), 1)
+      : sys_(sys), ex_(ex), opt_(opt), comm_(comm), rows_(sys.rows()), nc_(sys.num_contacts()),
+        cones_(sys, opt.friction), state_(nc_), all_rows_(sys.contact_dofs(), 1)
   {
   }
 
@@ -74,7 +73,7 @@ class StepSolver {
   const Cones cones_;
   std::vector<ContactState> state_;
   const std::vector<unsigned char> all_rows_;
-  Vector b_full_;  // the rhs with every row active and no fixed impulses
+  Vector b_full_; // the rhs with every row active and no fixed impulses
   StopReason last_reason_ = StopReason::converged;
 };
 
@@ -198,7 +197,7 @@ int StepSolver::update_set(const Vector &lambda, const std::vector<unsigned char
     ContactState &st = state_[c];
     const double ln = value[base(c)];
     if (st.released && ln > 0) {
-      ++changes;  // also when blocked: the set is then not settled, only frozen
+      ++changes; // also when blocked: the set is then not settled, only frozen
       if (st.reactivations < kMaxReversals) {
         ++st.reactivations;
         st.released = false;
@@ -217,7 +216,7 @@ int StepSolver::update_set(const Vector &lambda, const std::vector<unsigned char
       const Eigen::Vector2d t = cone_values(value, base(c), kCones[k]);
       const double tn = t.norm();
       if (tn > radius) {
-        st.dir[k] = t / tn;  // against the slip the pass left
+        st.dir[k] = t / tn; // against the slip the pass left
         changes += !st.capped[k];
         st.capped[k] = true;
       } else if (st.capped[k] && tn < radius * (1 - 1e-9)) {
@@ -340,7 +339,7 @@ void StepSolver::active_set_loop(Vector &lambda, StepResult &res)
       if (!mask[row]) warm_active[row] = 0.0;
     const Vector solved = linear_solve(b, warm_active, stop, tight, res);
     ++res.active_set_passes;
-    lambda = solved + fixed;  // disjoint rows
+    lambda = solved + fixed; // disjoint rows
     sys_.set_row_mask(all_rows_);
     if (last_reason_ == StopReason::non_finite) break;
     const int changes = update_set(lambda, mask);
@@ -390,7 +389,7 @@ StepResult StepSolver::run(const Vector *warm)
   return res;
 }
 
-}  // namespace
+} // namespace
 
 StepResult solve_step(ContactSystem &sys, const Exchange &ex, const StepOptions &opt,
                       const Vector *warm, MPI_Comm comm)
@@ -399,4 +398,4 @@ StepResult solve_step(ContactSystem &sys, const Exchange &ex, const StepOptions 
   return solver.run(warm);
 }
 
-}  // namespace fibre
+} // namespace fibre

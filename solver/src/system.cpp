@@ -4,7 +4,6 @@
 #include <stdexcept>
 #include <string>
 
-
 namespace fibre {
 
 void tangent_frame(const Vec3 &n, Vec3 &t1, Vec3 &t2)
@@ -118,4 +117,4 @@ void ContactSystem::set_row_mask(const std::vector<unsigned char> &active)
     if (!row_active(row)) rhs_[row] = 0.0;
 }
 
-}  // namespace fibre
+} // namespace fibre

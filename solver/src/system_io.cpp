@@ -78,7 +78,7 @@ class Reader {
       split(line, tokens);
       if (!tokens.empty() && tokens[0][0] != '#') return true;
     }
-    ++line_no_;  // errors at the end point past the last line
+    ++line_no_; // errors at the end point past the last line
     return false;
   }
 
@@ -176,7 +176,7 @@ void check_unit(const Reader &in, const Vec3 &v, const std::string &what)
   if (std::abs(v.norm() - 1.0) > kUnitTol) in.fail(what + " is not a unit vector");
 }
 
-}  // namespace
+} // namespace
 
 void write_system(std::ostream &out, const ContactSystem &sys)
 {
@@ -189,7 +189,7 @@ void write_system(std::ostream &out, const ContactSystem &sys)
   s += ' ';
   put_real(s, sys.params().damping);
   s += "\nbodies " + std::to_string(sys.num_bodies()) + " " +
-      std::to_string(sys.num_owned_bodies()) + "\n";
+       std::to_string(sys.num_owned_bodies()) + "\n";
   out << s;
   for (const Body &b : sys.bodies()) {
     s.clear();
@@ -263,8 +263,8 @@ ContactSystem parse_system(std::string_view text)
   const int nb = in.count(t[1], "body count", 2 * kBodyFields);
   const long long owned = in.integer(t[2], "owned body count");
   if (owned < 0 || owned > nb)
-    in.fail("owned body count " + std::to_string(owned) + " is not in [0, " +
-            std::to_string(nb) + "]");
+    in.fail("owned body count " + std::to_string(owned) + " is not in [0, " + std::to_string(nb) +
+            "]");
   std::vector<Body> bodies(nb);
   for (int i = 0; i < nb; ++i) {
     const std::string what = "body " + std::to_string(i);
@@ -325,8 +325,8 @@ ContactSystem parse_system(std::string_view text)
   in.keyword(t, "mask", 1, "mask <count>");
   const int nmask = in.count(t[1], "mask count", 2);
   if (nmask != 0 && nmask != dofs)
-    in.fail("mask count " + std::to_string(nmask) + " is neither 0 nor rows * contacts = " +
-            std::to_string(dofs));
+    in.fail("mask count " + std::to_string(nmask) +
+            " is neither 0 nor rows * contacts = " + std::to_string(dofs));
   std::vector<unsigned char> mask(nmask);
   for (int i = 0; i < nmask; ++i) {
     in.need(t, "mask entry " + std::to_string(i) + " of " + std::to_string(nmask));
@@ -339,8 +339,8 @@ ContactSystem parse_system(std::string_view text)
   in.keyword(t, "rhs", 1, "rhs <count>");
   const int nrhs = in.count(t[1], "rhs count", 2);
   if (nrhs != dofs)
-    in.fail("rhs count " + std::to_string(nrhs) + " differs from rows * contacts = " +
-            std::to_string(dofs));
+    in.fail("rhs count " + std::to_string(nrhs) +
+            " differs from rows * contacts = " + std::to_string(dofs));
   Vector rhs(nrhs);
   for (int i = 0; i < nrhs; ++i) {
     in.need(t, "rhs entry " + std::to_string(i) + " of " + std::to_string(nrhs));
@@ -387,8 +387,8 @@ void write_coordinate(const std::string &path, const SparseMatrix &S, bool symme
 {
   std::ofstream out(path);
   if (!out) throw std::runtime_error("cannot open '" + path + "' for writing");
-  out << "%%MatrixMarket matrix coordinate real " << (symmetric ? "symmetric" : "general")
-      << "\n% " << comment << "\n";
+  out << "%%MatrixMarket matrix coordinate real " << (symmetric ? "symmetric" : "general") << "\n% "
+      << comment << "\n";
   long nnz = 0;
   for (Eigen::Index j = 0; j < S.outerSize(); ++j)
     for (SparseMatrix::InnerIterator it(S, j); it; ++it) nnz += !symmetric || it.row() >= it.col();
@@ -396,7 +396,7 @@ void write_coordinate(const std::string &path, const SparseMatrix &S, bool symme
   std::string s;
   for (Eigen::Index j = 0; j < S.outerSize(); ++j)
     for (SparseMatrix::InnerIterator it(S, j); it; ++it) {
-      if (symmetric && it.row() < it.col()) continue;  // lower triangle, as the format asks
+      if (symmetric && it.row() < it.col()) continue; // lower triangle, as the format asks
       s = std::to_string(it.row() + 1) + " " + std::to_string(it.col() + 1) + " ";
       put_real(s, it.value());
       s += '\n';
@@ -415,7 +415,7 @@ SparseMatrix diagonal_matrix(const Vector &d)
   return D;
 }
 
-}  // namespace
+} // namespace
 
 void export_matrix_market(const ContactSystem &sys, const std::string &prefix)
 {
@@ -443,4 +443,4 @@ void export_matrix_market(const ContactSystem &sys, const std::string &prefix)
   check_stream(out, "'" + path + "'");
 }
 
-}  // namespace fibre
+} // namespace fibre

@@ -32,4 +32,4 @@ std::string format_g(double x)
   return buf;
 }
 
-}  // namespace fibre
+} // namespace fibre

@@ -16,7 +16,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t *data, std::size_t size
   try {
     sys = fibre::parse_system(text);
   } catch (const std::runtime_error &) {
-    return 0;  // rejected with a message: fine
+    return 0; // rejected with a message: fine
   }
   std::ostringstream once, twice;
   fibre::write_system(once, sys);

@@ -35,8 +35,7 @@ inline Dense dense_G(const ContactSystem &sys)
         G.block<1, 3>(row, 6 * k.a + 3) = (k.point - sys.bodies()[k.a].x).cross(d).transpose();
         if (!k.is_wall()) {
           G.block<1, 3>(row, 6 * k.b) = -d.transpose();
-          G.block<1, 3>(row, 6 * k.b + 3) =
-              -(k.point - sys.bodies()[k.b].x).cross(d).transpose();
+          G.block<1, 3>(row, 6 * k.b + 3) = -(k.point - sys.bodies()[k.b].x).cross(d).transpose();
         }
       } else {
         G.block<1, 3>(row, 6 * k.a + 3) = d.transpose();
@@ -68,8 +67,8 @@ inline Eigen::VectorXd dense_sigma(const ContactSystem &sys)
     for (int r = 0; r < sys.rows(); ++r) {
       const Eigen::Index row = Eigen::Index(sys.rows()) * c + r;
       s[row] = sys.row_active(row)
-          ? 4.0 * sys.contacts()[c].compliance[r] / (p.h * p.h * (1.0 + 4.0 * p.damping))
-          : 1.0;
+                   ? 4.0 * sys.contacts()[c].compliance[r] / (p.h * p.h * (1.0 + 4.0 * p.damping))
+                   : 1.0;
     }
   return s;
 }
@@ -92,4 +91,4 @@ inline Dense dense_K(const ContactSystem &sys)
   return K;
 }
 
-}  // namespace fibre::test
+} // namespace fibre::test

@@ -1,5 +1,6 @@
 // Report: Krylov iterations to a relative velocity error of 1e-6, per form x preconditioner x
-// method, on the 400-sphere pile poured by native LAMMPS (tests/data/pile400.dump) with Sigma scaled relative to G M^-1 G^T (design.md section 7).
+// method, on the 400-sphere pile poured by native LAMMPS (tests/data/pile400.dump) with Sigma
+// scaled relative to G M^-1 G^T (doc/design.md section 7).
 //
 // sigma_rel = sigma / mean(diag(G M^-1 G^T)) takes 1e-12 .. 1e-4. Two right-hand sides:
 // the SPOOK rhs with its gap term (inconsistent gaps put part of b into null(G^T)), and the
@@ -75,7 +76,7 @@ double mean_schur_diagonal(const ContactSystem &sys)
 
 struct Reference {
   Vector dv;
-  double refinement = 0;  // relative size of the refinement correction: accuracy estimate
+  double refinement = 0; // relative size of the refinement correction: accuracy estimate
 };
 
 Reference body_reference(const ContactSystem &sys, const Vector &b)
@@ -99,8 +100,7 @@ double null_share(const ContactSystem &unit_sys, const Vector &b)
 {
   // unit_sys has Sigma = I, so K - M = G^T G.
   Sparse GtG = assemble_body_matrix(unit_sys);
-  for (int i = 0; i < unit_sys.body_dofs(); ++i)
-    GtG.coeffRef(i, i) -= 1.0 / unit_sys.inv_mass()[i];
+  for (int i = 0; i < unit_sys.body_dofs(); ++i) GtG.coeffRef(i, i) -= 1.0 / unit_sys.inv_mass()[i];
   Eigen::SimplicialLDLT<Sparse> ldlt(GtG);
   Vector Gtb;
   gt_apply(unit_sys, b, Gtb);
@@ -118,15 +118,15 @@ ContactSystem with_compliance(const std::vector<Body> &bodies, std::vector<Conta
 }
 
 struct Measured {
-  int iterations = -1;  // to the target, -1: not reached
-  double best = 0;      // smallest velocity error seen
-  double worst = 0;     // largest velocity error seen after iteration 0
+  int iterations = -1; // to the target, -1: not reached
+  double best = 0;     // smallest velocity error seen
+  double worst = 0;    // largest velocity error seen after iteration 0
   double rel_residual = 0;
   StopReason reason = StopReason::max_iterations;
 };
 
 Measured measure(const ContactSystem &sys, Form form, PrecondKind kind, Method m, const Vector &b,
-            const Vector &dv_ref)
+                 const Vector &dv_ref)
 {
   const auto A = make_operator(form, sys, serial_exchange());
   PrecondOptions popt;
@@ -140,7 +140,7 @@ Measured measure(const ContactSystem &sys, Form form, PrecondKind kind, Method m
     return (dv - dv_ref).norm() / ref_norm;
   };
   StopControl stop;
-  stop.tol = 0;  // the velocity error decides
+  stop.tol = 0; // the velocity error decides
   stop.max_iter = kMaxIter;
   stop.accept = [&](int, const Vector &x) {
     const double e = velocity_error(x);
@@ -172,7 +172,7 @@ std::string cell(const Measured &r)
   return buf;
 }
 
-}  // namespace
+} // namespace
 
 TEST(Report, ConvergenceToVelocityError)
 {

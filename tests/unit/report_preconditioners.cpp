@@ -2,7 +2,7 @@
 // apply times of the preconditioners against the number of contacts.
 //
 // Scenes: pile_scene(400) and pile_scene(2000) (ballistic deposition), and the 400-sphere pile
-// poured by native LAMMPS (tests/data/pile400.dump, design.md section 7). For the impulse
+// poured by native LAMMPS (tests/data/pile400.dump, doc/design.md section 7). For the impulse
 // weight, the normal impulses come from a solve of the step (body form, tree preconditioner).
 // Times are the best of several runs (steady clock) on whatever machine runs the report.
 #include <gtest/gtest.h>
@@ -30,7 +30,7 @@ int wall_contacts(const ContactSystem &sys)
   return n;
 }
 
-// Normal impulses of the step: lambda from the body form (design.md section 7).
+// Normal impulses of the step: lambda from the body form (doc/design.md section 7).
 Vector normal_impulses(const ContactSystem &sys)
 {
   const Exchange &ex = serial_exchange();
@@ -80,7 +80,7 @@ void fibre_table(const std::string &name, const ContactSystem &sys)
     EXPECT_GT(s.num_fibres, 0);
     EXPECT_GT(s.covered_fraction(), 0.0);
     EXPECT_LE(s.covered_fraction(), 1.0);
-    EXPECT_GE(t.stats.covered_fraction(), s.covered_fraction());  // the forest holds the fibres
+    EXPECT_GE(t.stats.covered_fraction(), s.covered_fraction()); // the forest holds the fibres
   }
   // Where fibres lie: share of fibre contacts whose normal is within 30 degrees of vertical.
   for (EdgeWeight w : kWeights) {
@@ -115,7 +115,7 @@ template <class F> double best_ms(F f, int reps)
   return best;
 }
 
-}  // namespace
+} // namespace
 
 TEST(ReportPreconditioners, FibreStatistics)
 {

@@ -1,5 +1,5 @@
-// Report: kappa_e (design.md section 4) of every preconditioner on pile_scene(400), in both
-// forms, ordered as measured. Compare with the prototype table of design.md section 7.
+// Report: kappa_e (doc/design.md section 4) of every preconditioner on pile_scene(400), in both
+// forms, ordered as measured. Compare with the prototype table of doc/design.md section 7.
 //
 // Sigma = 1e-8 as in that table (t = 1e-8; the compliance is chosen to give it): null(G^T)
 // then sits far below the range of G, which is the gap kappa_e is about. Lanczos (capped)
@@ -37,7 +37,7 @@ std::string decades(const std::vector<double> &ev)
   std::string s;
   for (int d = lo; d <= hi; ++d)
     s += (d > lo ? " " : "") + std::string("1e") + std::to_string(d) + ":" +
-        std::to_string(count[d - lo]);
+         std::to_string(count[d - lo]);
   return s;
 }
 
@@ -48,7 +48,7 @@ Row measure(Form form, PrecondKind kind, const ContactSystem &sys)
   const auto t0 = std::chrono::steady_clock::now();
   const auto P = make_preconditioner(form, sys, serial_exchange(), opt);
   LanczosOptions lo;
-  lo.max_steps = 150;  // beyond this the dense path is cheaper here
+  lo.max_steps = 150; // beyond this the dense path is cheaper here
   Row row{kind, lanczos_spectrum(form, sys, serial_exchange(), *P, lo), "", 0};
   if (row.s.converged) {
     row.method = "lanczos " + std::to_string(row.s.iterations);
@@ -60,7 +60,7 @@ Row measure(Form form, PrecondKind kind, const ContactSystem &sys)
   return row;
 }
 
-}  // namespace
+} // namespace
 
 TEST(Report, KappaEffectiveOnPile400)
 {
@@ -86,9 +86,9 @@ TEST(Report, KappaEffectiveOnPile400)
     std::printf("  %-7s %12s %12s %11s %11s %10s  %-12s %6s\n", "precond", "kappa_e", "kappa",
                 "lambda_1", "lambda_r", "gap", "method", "s");
     for (const Row &r : rows) {
-      std::printf("  %-7s %12.4g %12.4g %11.4g %11.4g %10.3g  %-12s %6.2f\n",
-                  to_string(r.kind), r.s.kappa_e, r.s.kappa, r.s.lambda_max, r.s.lambda_r,
-                  r.s.gap_ratio, r.method.c_str(), r.seconds);
+      std::printf("  %-7s %12.4g %12.4g %11.4g %11.4g %10.3g  %-12s %6.2f\n", to_string(r.kind),
+                  r.s.kappa_e, r.s.kappa, r.s.lambda_max, r.s.lambda_r, r.s.gap_ratio,
+                  r.method.c_str(), r.seconds);
       EXPECT_GE(r.s.kappa_e, 1.0);
       EXPECT_LE(r.s.kappa_e, r.s.kappa * (1 + 1e-12));
     }

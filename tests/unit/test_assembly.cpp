@@ -50,7 +50,7 @@ Eigen::VectorXd dense_rhs(const ContactSystem &sys)
   return b;
 }
 
-}  // namespace
+} // namespace
 
 TEST(Assembly, GridMatchesDense)
 {

@@ -21,7 +21,7 @@ DetectedContact contact_on(int store, double key, const Vec3 &normal)
   return fc;
 }
 
-}  // namespace
+} // namespace
 
 TEST(ContactHistory, StoreThenWarmStartGivesTheImpulsesBack)
 {
@@ -53,11 +53,11 @@ TEST(ContactHistory, WarmStartFollowsTheWorldFrame)
   hist.grow(1);
   std::vector<DetectedContact> found = {contact_on(0, 5.0, Vec3::UnitZ())};
   Vector lambda = Vector::Zero(3);
-  lambda[0] = 2.0;  // along +z
+  lambda[0] = 2.0; // along +z
   hist.store(found, lambda, 3, h, 1);
   found[0] = contact_on(0, 5.0, Vec3::UnitX());
   const Vector warm = hist.warm_start(found, 3, h);
-  EXPECT_NEAR(warm[0], 0.0, 1e-15);  // the normal row sees no force now
+  EXPECT_NEAR(warm[0], 0.0, 1e-15); // the normal row sees no force now
   const Contact &k = found[0].contact;
   EXPECT_NEAR(warm[1], 2.0 * k.t1.z(), 1e-15);
   EXPECT_NEAR(warm[2], 2.0 * k.t2.z(), 1e-15);
@@ -109,7 +109,7 @@ TEST(ContactHistory, OverflowIsCountedNotStored)
   EXPECT_EQ(hist.store(found, lambda, 3, 1.0, 1), 3);
   EXPECT_EQ(hist.packed_size(0), ContactHistory::kMaxPacked);
   const Vector warm = hist.warm_start(found, 3, 1.0);
-  EXPECT_EQ(warm.tail(9).norm(), 0.0);  // the last three start cold
+  EXPECT_EQ(warm.tail(9).norm(), 0.0); // the last three start cold
   EXPECT_LT((warm.head(3 * ContactHistory::kMaxSlots) - lambda.head(3 * ContactHistory::kMaxSlots))
                 .norm(),
             1e-14);

@@ -22,16 +22,16 @@ Body sphere(double r, const Vec3 &x, const Vec3 &v = Vec3::Zero(), const Vec3 &f
   return b;
 }
 
-}  // namespace
+} // namespace
 
 // Within 1% of the smaller radius a pair is a contact whatever its motion.
 TEST(Detection, MarginMakesRestingNeighboursContacts)
 {
   const Body a = sphere(0.5, Vec3(0, 0, 1)), b = sphere(0.25, Vec3(0, 0, 0));
   const Vec3 n = Vec3::UnitZ();
-  EXPECT_TRUE(is_contact(a, &b, n, 0.0024, 1e-3, 2.0));   // below 0.01 * 0.25
-  EXPECT_FALSE(is_contact(a, &b, n, 0.0026, 1e-3, 2.0));  // above, at rest
-  EXPECT_TRUE(is_contact(a, &b, n, -0.1, 1e-3, 2.0));     // overlapping
+  EXPECT_TRUE(is_contact(a, &b, n, 0.0024, 1e-3, 2.0));  // below 0.01 * 0.25
+  EXPECT_FALSE(is_contact(a, &b, n, 0.0026, 1e-3, 2.0)); // above, at rest
+  EXPECT_TRUE(is_contact(a, &b, n, -0.1, 1e-3, 2.0));    // overlapping
 }
 
 // Beyond the margin a pair is a contact when it closes within (damping + 1) steps at its
@@ -39,7 +39,7 @@ TEST(Detection, MarginMakesRestingNeighboursContacts)
 TEST(Detection, ApproachWithinDampingPlusOneSteps)
 {
   const double h = 0.01, d = 2.0, r = 0.5;
-  const Vec3 n = Vec3::UnitZ();  // from b to a
+  const Vec3 n = Vec3::UnitZ(); // from b to a
   const Body b = sphere(r, Vec3::Zero());
   // approach 1 m/s: reach (d + 1) h * 1 = 0.03 beyond the margin 0.005
   const Body a = sphere(r, Vec3(0, 0, 1.1), Vec3(0, 0, -1.0));

@@ -67,7 +67,7 @@ void expect_both_forms_match_dense(const ContactSystem &sys, double tol)
   EXPECT_LT(rel_diff(velocities(sys, lb), velocities(sys, lc)), 1e-10);
 }
 
-}  // namespace
+} // namespace
 
 TEST(DistributedCholesky, SmallSpdMatrixFromMixedTriangles)
 {
@@ -181,8 +181,7 @@ TEST(DirectSolve, RejectsWrongRhsSize)
 {
   SceneParams p;
   const ContactSystem sys = grid_scene(p);
-  EXPECT_THROW(direct_solve(Form::contact, sys, serial_exchange(), Vector::Zero(3),
-                            MPI_COMM_SELF),
+  EXPECT_THROW(direct_solve(Form::contact, sys, serial_exchange(), Vector::Zero(3), MPI_COMM_SELF),
                std::invalid_argument);
 }
 
@@ -245,8 +244,8 @@ class SlabExchange final : public Exchange {
 
 struct LocalPart {
   ContactSystem sys;
-  std::vector<int> l2g;           // local body -> scene body
-  std::vector<int> contact_ids;   // local contact -> scene contact
+  std::vector<int> l2g;         // local body -> scene body
+  std::vector<int> contact_ids; // local contact -> scene contact
 };
 
 LocalPart split(const ContactSystem &full, int rank, int nprocs)
@@ -284,8 +283,8 @@ LocalPart split(const ContactSystem &full, int rank, int nprocs)
   }
   std::vector<Body> bodies;
   for (int g : part.l2g) bodies.push_back(full.bodies()[g]);
-  part.sys = ContactSystem(std::move(bodies), std::move(contacts), full.rows(), full.params(),
-                           owned);
+  part.sys =
+      ContactSystem(std::move(bodies), std::move(contacts), full.rows(), full.params(), owned);
   part.sys.set_rhs(spook_rhs(part.sys));
   return part;
 }
@@ -294,8 +293,7 @@ void distributed_matches_serial(const ContactSystem &full, Form form)
 {
   const int rank = world_rank(), nprocs = world_size();
   const LocalPart part = split(full, rank, nprocs);
-  const SlabExchange ex(MPI_COMM_WORLD, full.num_bodies(), part.l2g,
-                        part.sys.num_owned_bodies());
+  const SlabExchange ex(MPI_COMM_WORLD, full.num_bodies(), part.l2g, part.sys.num_owned_bodies());
   // The local rhs equals the serial one on this rank's contacts.
   Vector b_ref(part.sys.contact_dofs());
   const int rows = full.rows();
@@ -317,7 +315,7 @@ void distributed_matches_serial(const ContactSystem &full, Form form)
   EXPECT_GT(part.sys.num_bodies(), part.sys.num_owned_bodies());
 }
 
-}  // namespace
+} // namespace
 
 TEST(DirectMPI, DistributedBodyFormMatchesDense)
 {
@@ -343,7 +341,7 @@ TEST(DirectMPI, DistributedCholeskyRoutesEntries)
       if (i + 1 < n) r.push_back(i + 1), c.push_back(i), v.push_back(-1.0);
     }
     if ((i + 1) % nprocs == rank) idx.push_back(i), val.push_back(1.0);
-    if (i % 5 == 0) idx.push_back(i), val.push_back(1.0 / nprocs);  // summed over ranks
+    if (i % 5 == 0) idx.push_back(i), val.push_back(1.0 / nprocs); // summed over ranks
   }
   DistributedCholesky chol(MPI_COMM_WORLD);
   chol.factorize(n, r, c, v);
@@ -366,12 +364,10 @@ TEST(DirectMPI, DistributedLanczosMatchesDense)
   SceneParams p;
   const ContactSystem full = pile_scene(12, p);
   const LocalPart part = split(full, world_rank(), world_size());
-  const SlabExchange ex(MPI_COMM_WORLD, full.num_bodies(), part.l2g,
-                        part.sys.num_owned_bodies());
+  const SlabExchange ex(MPI_COMM_WORLD, full.num_bodies(), part.l2g, part.sys.num_owned_bodies());
   const IdentityPreconditioner none;
   for (Form form : {Form::contact, Form::body}) {
-    const Spectrum dense =
-        dense_spectrum(*make_operator(form, full, serial_exchange()), none);
+    const Spectrum dense = dense_spectrum(*make_operator(form, full, serial_exchange()), none);
     const Spectrum lanczos = lanczos_spectrum(form, part.sys, ex, none);
     EXPECT_NEAR(lanczos.kappa_e, dense.kappa_e, 1e-6 * dense.kappa_e) << to_string(form);
     EXPECT_NEAR(lanczos.lambda_max, dense.lambda_max, 1e-9 * dense.lambda_max);
@@ -394,8 +390,8 @@ TEST(DirectMPI, LaunchedUnderMpirun)
     if (const char *value = std::getenv(name)) env += std::string(" ") + name + "='" + value + "'";
   const std::string log = "/tmp/fibre_direct_mpi_" + std::to_string(getpid()) + ".log";
   for (int np : {2, 3}) {
-    const std::string cmd = env + " mpirun --oversubscribe -np " + std::to_string(np) + " " +
-        exe + " --gtest_filter='DirectMPI.Distributed*' > " + log + " 2>&1";
+    const std::string cmd = env + " mpirun --oversubscribe -np " + std::to_string(np) + " " + exe +
+                            " --gtest_filter='DirectMPI.Distributed*' > " + log + " 2>&1";
     const int status = std::system(cmd.c_str());
     std::string tail;
     if (FILE *f = std::fopen(log.c_str(), "r")) {

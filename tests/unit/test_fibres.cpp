@@ -39,7 +39,7 @@ bool is_edge(const ContactSystem &sys, const Contact &k, bool ghosts)
   return !k.is_wall() && k.a < limit && k.b < limit;
 }
 
-// Every property of design.md section 3 and fibres.hpp, from the contact list.
+// Every property of doc/design.md section 3 and fibres.hpp, from the contact list.
 void expect_valid_fibres(const ContactSystem &sys, const Fibres &f, bool ghosts)
 {
   const std::vector<Contact> &cs = sys.contacts();
@@ -114,7 +114,7 @@ std::vector<int> fibre_bodies(const Fibres &f, int k)
                           f.bodies.begin() + f.body_start[k + 1]);
 }
 
-}  // namespace
+} // namespace
 
 TEST(Fibres, WeightNames)
 {
@@ -172,8 +172,8 @@ TEST(Fibres, FibreGrowsBothWaysFromItsStart)
 {
   std::vector<Body> bodies(3);
   for (Body &b : bodies) b.radius = 0.5;
-  bodies[1].x = Vec3(1, 0, 0);  // level with 0
-  bodies[2].x = Vec3(0, 0, 1);  // above 0
+  bodies[1].x = Vec3(1, 0, 0); // level with 0
+  bodies[2].x = Vec3(0, 0, 1); // above 0
   std::vector<Contact> cs{sphere_sphere_contact(bodies, 2, 0), sphere_sphere_contact(bodies, 1, 0)};
   for (Contact &k : cs) k.compliance.fill(1e-8);
   const ContactSystem sys(bodies, cs, 6, SpookParams{});

@@ -79,7 +79,7 @@ class PoisonedOperator final : public LinearOperator {
   mutable int calls_ = 0;
 };
 
-}  // namespace
+} // namespace
 
 TEST(Krylov, Names)
 {
@@ -182,7 +182,7 @@ TEST(Krylov, CrAndMinresResidualsAreMonotone)
         const SolveResult res = krylov_solve(m, *A, *P, b, x, stop, &mon);
         ASSERT_EQ(res.reason, StopReason::converged);
         ASSERT_GE(res.history.size(), std::size_t(res.iterations) + 1);
-        EXPECT_DOUBLE_EQ(res.history[0].rel_residual, 1.0);  // x0 = 0
+        EXPECT_DOUBLE_EQ(res.history[0].rel_residual, 1.0); // x0 = 0
         EXPECT_NEAR(res.history[0].rel_residual_P, 1.0, 1e-12);
         // Up to the first restart from the true residual (a restart entry repeats its
         // iteration number and may legitimately sit above the updated residual).
@@ -196,7 +196,7 @@ TEST(Krylov, CrAndMinresResidualsAreMonotone)
                 << "iteration " << k;
           }
         }
-        EXPECT_LT(res.history[k - 1].rel_residual, 1e-9);  // the checked stretch is the run
+        EXPECT_LT(res.history[k - 1].rel_residual, 1e-9); // the checked stretch is the run
       }
     }
   }
@@ -212,9 +212,7 @@ TEST(Krylov, HistoryRecordsVelocityErrorAndNormA)
   KrylovMonitor mon;
   mon.record_history = true;
   mon.norm_A = 2.0;
-  mon.velocity_error = [&](const Vector &l) {
-    return rel_diff(ref.velocities(l), ref.dv);
-  };
+  mon.velocity_error = [&](const Vector &l) { return rel_diff(ref.velocities(l), ref.dv); };
   StopControl stop;
   stop.tol = 1e-12;
   stop.max_iter = 1000;
@@ -226,8 +224,7 @@ TEST(Krylov, HistoryRecordsVelocityErrorAndNormA)
     EXPECT_DOUBLE_EQ(res.history[0].velocity_error, 1.0);
     EXPECT_LT(res.history.back().velocity_error, 1e-9);
     for (const IterationRecord &rec : res.history)
-      EXPECT_NEAR(rec.rel_residual_A, rec.rel_residual * ref.b.norm() / 2.0,
-                  1e-12 * ref.b.norm());
+      EXPECT_NEAR(rec.rel_residual_A, rec.rel_residual * ref.b.norm() / 2.0, 1e-12 * ref.b.norm());
   }
 }
 
@@ -320,7 +317,7 @@ TEST(Krylov, BreakdownOnIndefiniteForCgButMinresSolvesIt)
   const DenseOperator A(M);
   const IdentityPreconditioner P;
   Vector b = Vector::Zero(n);
-  b[0] = 1.0;  // (b, A b) < 0: CG breaks down on its first step
+  b[0] = 1.0; // (b, A b) < 0: CG breaks down on its first step
   Vector x = Vector::Zero(n);
   SolveResult res = cg(A, P, b, x, StopControl{});
   EXPECT_EQ(res.reason, StopReason::breakdown);
@@ -346,7 +343,7 @@ TEST(Krylov, AcceptRuleStopsEarly)
   const SolveResult res = minres(A, P, sys.rhs(), x, stop);
   EXPECT_EQ(res.reason, StopReason::converged);
   EXPECT_EQ(res.iterations, 4);
-  EXPECT_GT(res.rel_residual, 1e-14);  // the reported residual stays honest
+  EXPECT_GT(res.rel_residual, 1e-14); // the reported residual stays honest
 }
 
 // Both forms give the same velocities, on a rhs with the gap term, dense and iterative.
@@ -355,7 +352,7 @@ TEST(Krylov, FormsAgreeOnVelocities)
   for (int which : {0, 1}) {
     ContactSystem sys = scene(which);
     const Reference ref(sys);
-    if (which == 1) {  // the pile's overlaps put the gap term into b
+    if (which == 1) { // the pile's overlaps put the gap term into b
       double gaps = 0;
       for (const Contact &c : sys.contacts()) gaps += std::abs(c.gap);
       EXPECT_GT(gaps, 0.0);

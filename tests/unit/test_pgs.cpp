@@ -32,7 +32,7 @@ Problem pile(int n, double mu)
   return pr;
 }
 
-}  // namespace
+} // namespace
 
 TEST(Pgs, ConvergesToTheSettledDirectAnswer)
 {
@@ -88,7 +88,7 @@ TEST(Pgs, TypedStopReasons)
   EXPECT_EQ(res.reason, StopReason::non_finite);
   EXPECT_EQ(res.sweeps, 1);
   EXPECT_TRUE(std::isnan(lambda[3]));
-  EXPECT_EQ(lambda.norm() != lambda.norm(), true);  // unchanged: the caller's start
+  EXPECT_EQ(lambda.norm() != lambda.norm(), true); // unchanged: the caller's start
 }
 
 // solver pgs in the step: no linear pass, and the sweeps' accuracy in the result.

@@ -176,7 +176,7 @@ void expect_all(const ContactSystem &sys, double tol = 1e-9, bool coupled = true
     }
 }
 
-}  // namespace
+} // namespace
 
 TEST(Preconditioners, Names)
 {
@@ -215,7 +215,7 @@ TEST(Preconditioners, MaskedRows)
   ContactSystem sys = pile_scene(40, SceneParams{});
   std::vector<unsigned char> mask(sys.contact_dofs(), 1);
   for (std::size_t i = 1; i < mask.size(); i += 5) mask[i] = 0;
-  for (int r = 0; r < 6; ++r) mask[6 * 3 + r] = 0;  // a whole contact released
+  for (int r = 0; r < 6; ++r) mask[6 * 3 + r] = 0; // a whole contact released
   sys.set_row_mask(mask);
   expect_all(sys);
 }
@@ -272,7 +272,7 @@ class CopyExchange final : public Exchange {
   long exclusive_prefix_sum(long) const override { return 0; }
 
  private:
-  std::vector<int> owner_;  // per body: its owner if a ghost, else -1
+  std::vector<int> owner_; // per body: its owner if a ghost, else -1
 };
 
 // Body form: the diagonal blocks of K gather the contacts held on ghost copies, so the
@@ -294,7 +294,7 @@ TEST(Preconditioners, HaloCompletesBodyBlocks)
   ContactSystem split(bodies, contacts, 6, whole.params(), n);
   split.set_rhs(whole.rhs());
   const CopyExchange ex(owner);
-  {  // the fake halo reproduces the whole system's K
+  { // the fake halo reproduces the whole system's K
     const Vector v = Vector::Random(whole.body_dofs());
     Vector vs = Vector::Zero(split.body_dofs()), kv, kvs;
     vs.head(v.size()) = v;

@@ -32,7 +32,7 @@ void expect_schur_matches_dense(const ContactSystem &sys)
   EXPECT_LT(rel_diff(kv, K * v), 1e-12);
 }
 
-}  // namespace
+} // namespace
 
 TEST(Schur, GridHasTwelveContacts)
 {
@@ -86,7 +86,8 @@ TEST(Schur, BlocksMatchDense)
   const test::Dense K = test::dense_K(sys);
   const std::vector<Mat6> kd = body_diagonal_blocks(sys);
   for (int i = 0; i < sys.num_bodies(); ++i)
-    EXPECT_LT((kd[i] - K.block(6 * i, 6 * i, 6, 6)).norm(), 1e-10 * K.block(6 * i, 6 * i, 6, 6).norm());
+    EXPECT_LT((kd[i] - K.block(6 * i, 6 * i, 6, 6)).norm(),
+              1e-10 * K.block(6 * i, 6 * i, 6, 6).norm());
   for (int c = 0; c < sys.num_contacts(); ++c) {
     const Contact &k = sys.contacts()[c];
     if (k.is_wall()) continue;
@@ -125,7 +126,7 @@ TEST(Schur, SpookRhsMatchesFormula)
   }
   Vector g = Vector::Zero(sys.contact_dofs());
   for (int c = 0; c < sys.num_contacts(); ++c) g[sys.rows() * c] = sys.contacts()[c].gap;
-  const Vector ref = -(4.0 / sp.h) * ups * g - (1 - ups) * G * v -
-      sp.h * G * test::dense_Minv(sys) * f;
+  const Vector ref =
+      -(4.0 / sp.h) * ups * g - (1 - ups) * G * v - sp.h * G * test::dense_Minv(sys) * f;
   EXPECT_LT(rel_diff(spook_rhs(sys), ref), 1e-12);
 }

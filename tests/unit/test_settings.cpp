@@ -29,7 +29,7 @@ std::string error_of(const std::string &text)
   return "";
 }
 
-}  // namespace
+} // namespace
 
 TEST(Settings, NoKeywordsKeepTheDefaults)
 {
@@ -68,7 +68,7 @@ TEST(Settings, EveryKeywordSetsWhatItNames)
             "active_set 4 sweeps 9 sweep_tol 1e-4 wall zplane 0 NULL wall xplane -1 1 "
             "wall region box export 10 out/sys"));
   EXPECT_EQ(s.step.form, Form::contact);
-  EXPECT_EQ(s.step.solver, Method::cg);  // uzawa is an alias
+  EXPECT_EQ(s.step.solver, Method::cg); // uzawa is an alias
   EXPECT_EQ(s.step.precond.kind, PrecondKind::fibre);
   EXPECT_EQ(s.step.precond.weight, EdgeWeight::impulse);
   EXPECT_DOUBLE_EQ(s.step.stop.tol, 1e-6);

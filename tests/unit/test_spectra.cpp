@@ -126,7 +126,7 @@ std::unique_ptr<Preconditioner> local_preconditioner(const std::string &kind, Fo
   return std::make_unique<BlockInverse>(form, sys, kind == "jacobi");
 }
 
-}  // namespace
+} // namespace
 
 TEST(Spectra, GapRuleOnKnownLists)
 {
@@ -164,7 +164,7 @@ TEST(Spectra, DenseRecoversAKnownPreconditionedSpectrum)
   Vector d(n), e(n);
   std::vector<double> expected;
   for (int i = 0; i < n; ++i) {
-    d[i] = (i < 10 ? 1e-6 : 1.0) * u(rng) * (1 + i);  // a null-like cluster of ten
+    d[i] = (i < 10 ? 1e-6 : 1.0) * u(rng) * (1 + i); // a null-like cluster of ten
     e[i] = u(rng);
     expected.push_back(d[i] * e[i]);
   }
@@ -176,7 +176,7 @@ TEST(Spectra, DenseRecoversAKnownPreconditionedSpectrum)
   for (int i = 0; i < n; ++i)
     EXPECT_NEAR(s.eigenvalues[i], ref.eigenvalues[i], 1e-10 * ref.eigenvalues[0]) << i;
   EXPECT_EQ(s.r, ref.r);
-  EXPECT_EQ(s.r, n - 11);  // the last eigenvalue above the cluster
+  EXPECT_EQ(s.r, n - 11); // the last eigenvalue above the cluster
   EXPECT_NEAR(s.kappa_e, ref.kappa_e, 1e-10 * ref.kappa_e);
 }
 
@@ -240,7 +240,7 @@ TEST(Spectra, LanczosFindsAClearGapLongBeforeN)
 
 TEST(Spectra, LanczosMatchesDenseOnPilesBothForms)
 {
-  // Sigma = 1e-8 as in design.md section 7: null(G^T) sits far below the range of G.
+  // Sigma = 1e-8 as in doc/design.md section 7: null(G^T) sits far below the range of G.
   const ContactSystem sys = pile_scene(kPile, design_sigma_params());
   for (Form form : {Form::contact, Form::body}) {
     const auto op = make_operator(form, sys, serial_exchange());
@@ -281,8 +281,7 @@ TEST(Spectra, BodySpaceRouteMatchesDenseContactSpectrum)
     const ContactSystem sys = pile_scene(80, p);
     const Spectrum body = body_space_spectrum(sys);
     // Reference: the eigenvalues of the dense A of reference.hpp.
-    Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> es(test::dense_A(sys),
-                                                      Eigen::EigenvaluesOnly);
+    Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> es(test::dense_A(sys), Eigen::EigenvaluesOnly);
     const Vector &ev = es.eigenvalues();
     const Spectrum ref = effective_condition(std::vector<double>(ev.data(), ev.data() + ev.size()));
     ASSERT_EQ(body.eigenvalues.size(), ref.eigenvalues.size());

@@ -29,8 +29,8 @@ SpookParams spook()
 }
 
 // eps 1e-14 gives Sigma ~ 4e-9: the regularization shifts impulses by ~1e-8 relative.
-ContactSystem make_system(const std::vector<Body> &bodies, std::vector<Contact> contacts,
-                          int rows, double eps = 1e-14)
+ContactSystem make_system(const std::vector<Body> &bodies, std::vector<Contact> contacts, int rows,
+                          double eps = 1e-14)
 {
   for (Contact &c : contacts) c.compliance.fill(eps);
   return ContactSystem(bodies, std::move(contacts), rows, spook());
@@ -65,8 +65,7 @@ std::vector<StepOptions> all_options()
 {
   std::vector<StepOptions> out;
   for (Form form : {Form::contact, Form::body})
-    for (Method s : {Method::cg, Method::cr, Method::minres,
-                         Method::direct}) {
+    for (Method s : {Method::cg, Method::cr, Method::minres, Method::direct}) {
       StepOptions o = base_options();
       o.form = form;
       o.solver = s;
@@ -88,12 +87,11 @@ StepResult solve(ContactSystem &sys, const StepOptions &o, const Vector *warm = 
   return solve_step(sys, serial_exchange(), o, warm, MPI_COMM_SELF);
 }
 
-}  // namespace
+} // namespace
 
 TEST(ContactSolver, SolverNames)
 {
-  for (Method s : {Method::cg, Method::cr, Method::minres,
-                       Method::direct}) {
+  for (Method s : {Method::cg, Method::cr, Method::minres, Method::direct}) {
     Method back;
     ASSERT_TRUE(parse(to_string(s), back));
     EXPECT_EQ(back, s);
@@ -162,14 +160,14 @@ TEST(ContactSolver, PulledSphereSticksOrSlides)
   const double m = 1.5, r = 0.4, mu = 0.5;
   struct Case {
     int rows;
-    double pull;      // F / (m g)
-    double friction;  // expected lambda_t1 / (h m g); t1 = x for a floor contact
+    double pull;     // F / (m g)
+    double friction; // expected lambda_t1 / (h m g); t1 = x for a floor contact
   };
   const Case cases[] = {
-      {6, 0.3, -0.3},       // sticks
-      {6, 0.8, -mu},        // slides
-      {3, 0.2, -0.2 * 2 / 7},  // rolls without slipping
-      {3, 3.0, -mu},        // rolls and slips
+      {6, 0.3, -0.3},         // sticks
+      {6, 0.8, -mu},          // slides
+      {3, 0.2, -0.2 * 2 / 7}, // rolls without slipping
+      {3, 3.0, -mu},          // rolls and slips
   };
   for (const Case &cs : cases) {
     std::vector<Body> bodies{sphere(m, r, Vec3(0, 0, r))};
@@ -237,7 +235,7 @@ TEST(ContactSolver, ConservesMomentum)
   for (StepOptions o : all_options()) {
     o.friction.mu_roll = 0.05;
     o.friction.mu_twist = 0.05;
-    o.stop.tol = 1e-6;  // conservation must not depend on the accuracy
+    o.stop.tol = 1e-6; // conservation must not depend on the accuracy
     SCOPED_TRACE(label(o));
     const StepResult res = solve(sys, o);
     Vec3 momentum = Vec3::Zero(), angular = Vec3::Zero();
@@ -245,8 +243,8 @@ TEST(ContactSolver, ConservesMomentum)
     for (int i = 0; i < sys.num_bodies(); ++i) {
       const Body &b = sys.bodies()[i];
       const Vec3 dp = b.mass * res.dv.segment<3>(6 * i);
-      const Vec3 dl = 0.4 * b.mass * b.radius * b.radius * res.dv.segment<3>(6 * i + 3) +
-                      b.x.cross(dp);
+      const Vec3 dl =
+          0.4 * b.mass * b.radius * b.radius * res.dv.segment<3>(6 * i + 3) + b.x.cross(dp);
       momentum += dp;
       angular += dl;
       scale += dp.norm();
@@ -298,9 +296,9 @@ TEST(ContactSolver, FeasibleAndConsistentOnPile)
       }
       EXPECT_NEAR(rho[k], 0.0, tol) << "normal row of contact " << c;
       const double r_eff = sys.contacts()[c].is_wall()
-          ? sys.bodies()[sys.contacts()[c].a].radius
-          : 1.0 / (1.0 / sys.bodies()[sys.contacts()[c].a].radius +
-                   1.0 / sys.bodies()[sys.contacts()[c].b].radius);
+                               ? sys.bodies()[sys.contacts()[c].a].radius
+                               : 1.0 / (1.0 / sys.bodies()[sys.contacts()[c].a].radius +
+                                        1.0 / sys.bodies()[sys.contacts()[c].b].radius);
       const struct {
         int first, size;
         double radius;
@@ -334,8 +332,8 @@ TEST(ContactSolver, FormsAndSolversAgree)
   ASSERT_TRUE(ref.set_settled);
   for (StepOptions o : all_options()) {
     o.active_set_max = 60;
-    for (PrecondKind kind : {PrecondKind::none, PrecondKind::block, PrecondKind::fibre,
-                             PrecondKind::tree}) {
+    for (PrecondKind kind :
+         {PrecondKind::none, PrecondKind::block, PrecondKind::fibre, PrecondKind::tree}) {
       if (o.solver == Method::direct && kind != PrecondKind::none) continue;
       o.precond.kind = kind;
       SCOPED_TRACE(label(o) + " " + to_string(kind));
@@ -390,7 +388,7 @@ TEST(ContactSolver, SweepsFinishAnUnsettledLoop)
   const StepResult ref = solve(sys, ref_opt);
   ASSERT_TRUE(ref.set_settled);
   EXPECT_LT(ref.complementarity, 1e-5);
-  EXPECT_EQ(ref.sweeps, 0);  // a settled loop is accurate already
+  EXPECT_EQ(ref.sweeps, 0); // a settled loop is accurate already
 
   StepOptions o = ref_opt;
   o.solver = Method::cr;

@@ -27,7 +27,7 @@ ContactSystem sample_system(int rows = 6)
   p.spook.damping = 2.5;
   const ContactSystem pile = pile_scene(25, p);
   std::vector<Body> bodies = pile.bodies();
-  bodies[0].v = Vec3(-0.0, 1e-310, 0.1);  // signed zero and a subnormal
+  bodies[0].v = Vec3(-0.0, 1e-310, 0.1); // signed zero and a subnormal
   bodies[1].torque = Vec3(1e300, -1.0 / 7.0, 3.0);
   std::vector<Contact> contacts = pile.contacts();
   contacts[0].compliance = {1e-8, 2e-8, 3e-8, 4e-8, 5e-8, 6e-8};
@@ -136,7 +136,7 @@ std::string temp_path(const std::string &name)
   return "/tmp/fibre_io_" + std::to_string(getpid()) + "_" + name;
 }
 
-}  // namespace
+} // namespace
 
 TEST(SystemIo, RoundTripIsExact)
 {
@@ -146,7 +146,7 @@ TEST(SystemIo, RoundTripIsExact)
     EXPECT_EQ(text.rfind("fibre_contact_system 1\n", 0), 0u);
     const ContactSystem back = parse_system(text);
     expect_identical(sys, back);
-    EXPECT_EQ(to_text(back), text);  // and the writer is deterministic
+    EXPECT_EQ(to_text(back), text); // and the writer is deterministic
   }
 }
 
@@ -204,11 +204,11 @@ TEST(SystemIo, EachMalformedInputGetsItsOwnError)
   {
     const long n = static_cast<long>(sys.contact_dofs());
     std::vector<std::string> v(L.begin(), L.begin() + rhs + 1 + n / 2);
-    expect_error(join(v), {"unexpected end of input, expected rhs entry " +
-                               std::to_string(n / 2) + " of " + std::to_string(n)});
-    const std::size_t last = mask - 1;  // the last contact line
+    expect_error(join(v), {"unexpected end of input, expected rhs entry " + std::to_string(n / 2) +
+                           " of " + std::to_string(n)});
+    const std::size_t last = mask - 1; // the last contact line
     const std::string cut = join(std::vector<std::string>(L.begin(), L.begin() + last)) +
-        L[last].substr(0, L[last].size() / 2);
+                            L[last].substr(0, L[last].size() / 2);
     expect_error(cut, {line_tag(last), "contact " + std::to_string(sys.num_contacts() - 1) +
                                            ": expected 21 values"});
     expect_error(text.substr(0, text.size() - 4), {"unexpected end of input", "'end'"});
@@ -314,7 +314,7 @@ Market read_market(const std::string &path)
   return m;
 }
 
-}  // namespace
+} // namespace
 
 TEST(SystemIo, MatrixMarketExportMatchesDenseReference)
 {

@@ -1,12 +1,12 @@
 // Convergence and spectral analysis of one contact system, per form x Krylov method x
 // preconditioner: the measurements of the thesis (sections 5-6: r_r, v_e, kappa_e, Tables 1-2,
-// Figures 16-24) and of design.md sections 4 and 7. fibre_analyze is its command line.
+// Figures 16-24) and of doc/design.md sections 4 and 7. fibre_analyze is its command line.
 //
 // The reference is direct (MUMPS):
 // - dv* = M^-1 G^T lambda*, the velocity change of the exact solution, from the body form
 //   K dv = G^T Sigma^-1 b (K = M + G^T Sigma^-1 G) plus one step of refinement. This is the
 //   accurate way to the velocities: the contact form carries a 1/Sigma-sized lambda component
-//   in null(G^T) that G^T must cancel in floating point (design.md section 7).
+//   in null(G^T) that G^T must cancel in floating point (doc/design.md section 7).
 // - lambda* from the contact form A lambda = b; its velocities are compared with dv*, so that
 //   the attainable accuracy of the contact form shows.
 //

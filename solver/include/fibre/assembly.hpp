@@ -13,7 +13,7 @@
 
 namespace fibre {
 
-using SparseMatrix = Eigen::SparseMatrix<double>;  // column major
+using SparseMatrix = Eigen::SparseMatrix<double>; // column major
 
 // G: rows() rows per contact, 6 columns per body (thesis eq. 2.1.1); masked rows are empty.
 SparseMatrix assemble_G(const ContactSystem &sys);
@@ -37,4 +37,4 @@ Vector assemble_rhs(const ContactSystem &sys);
 void upper_triplets(const SparseMatrix &S, std::vector<long> &rows, std::vector<long> &cols,
                     std::vector<double> &values);
 
-}  // namespace fibre
+} // namespace fibre

@@ -15,10 +15,13 @@
 namespace fibre {
 
 struct Cone {
-  int first, size;  // first row within the contact, 1 or 2 rows
+  int first, size; // first row within the contact, 1 or 2 rows
 };
 inline constexpr Cone kCones[3] = {{1, 2}, {3, 1}, {4, 2}};
-inline int num_cones(int rows) { return rows == 6 ? 3 : 1; }
+inline int num_cones(int rows)
+{
+  return rows == 6 ? 3 : 1;
+}
 
 inline Eigen::Vector2d cone_values(const Vector &v, Eigen::Index base, const Cone &cone)
 {
@@ -64,4 +67,4 @@ std::vector<Vec6> row_scales(const ContactSystem &sys);
 double complementarity(const ContactSystem &sys, const Exchange &ex, const Cones &cones,
                        const Vector &b, const Vector &lambda, const std::vector<Vec6> &scale);
 
-}  // namespace fibre
+} // namespace fibre

@@ -19,7 +19,7 @@ class ContactHistory {
   static constexpr int kSlotSize = 7;
   static constexpr int kMaxPacked = 1 + kMaxSlots * kSlotSize;
 
-  void grow(int nmax);  // room for atoms [0, nmax); new atoms have no contacts
+  void grow(int nmax); // room for atoms [0, nmax); new atoms have no contacts
   int capacity() const { return static_cast<int>(count_.size()); }
   void clear(int i) { count_[i] = 0; }
   void copy(int from, int to);
@@ -42,7 +42,7 @@ class ContactHistory {
  private:
   const double *find(int atom, double key) const;
   std::vector<int> count_;
-  std::vector<double> slots_;  // kMaxSlots * kSlotSize per atom
+  std::vector<double> slots_; // kMaxSlots * kSlotSize per atom
 };
 
-}  // namespace fibre
+} // namespace fibre

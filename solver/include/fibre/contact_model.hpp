@@ -11,9 +11,9 @@ namespace fibre {
 // A zero coefficient means no resistance: those rows never enter the solve and carry no
 // impulse.
 struct FrictionParams {
-  double mu = 0.5;        // Coulomb: |lambda_t| <= mu lambda_n
-  double mu_roll = 0.0;   // rolling: |lambda_roll| <= mu_roll r_eff lambda_n
-  double mu_twist = 0.0;  // twisting: |lambda_twist| <= mu_twist r_eff lambda_n
+  double mu = 0.5;       // Coulomb: |lambda_t| <= mu lambda_n
+  double mu_roll = 0.0;  // rolling: |lambda_roll| <= mu_roll r_eff lambda_n
+  double mu_twist = 0.0; // twisting: |lambda_twist| <= mu_twist r_eff lambda_n
 };
 
 // How stiff the rows are. auto: eps = factor dt^2 / m_min on every translational row, so that
@@ -22,14 +22,14 @@ struct FrictionParams {
 // eps_t / r_eff^2 in both modes.
 struct ComplianceParams {
   bool automatic = true;
-  double eps_n = 0.0, eps_t = 0.0;  // fixed mode
-  double factor = 1e-2;             // automatic mode
+  double eps_n = 0.0, eps_t = 0.0; // fixed mode
+  double factor = 1e-2;            // automatic mode
 };
 
 // The model of one simulation: rows per contact, SPOOK damping, compliance and friction.
 struct ContactModel {
-  int rows = 6;          // 3: translational rows only; 6: with twisting and rolling
-  double damping = 2.0;  // SPOOK d = tau / h, in steps
+  int rows = 6;         // 3: translational rows only; 6: with twisting and rolling
+  double damping = 2.0; // SPOOK d = tau / h, in steps
   ComplianceParams compliance{};
   FrictionParams friction{};
 };
@@ -49,4 +49,4 @@ double cone_coefficient(const FrictionParams &f, double r_eff, int cone);
 void set_compliance(const ComplianceParams &p, double h, double m_min,
                     const std::vector<Body> &bodies, std::vector<Contact> &contacts);
 
-}  // namespace fibre
+} // namespace fibre

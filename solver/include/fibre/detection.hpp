@@ -16,13 +16,15 @@ namespace fibre {
 inline constexpr double kContactMargin = 0.01;
 // Wall contacts are keyed by wall and sub-wall (plane lo/hi, a region's sub-surface).
 inline constexpr int kWallKeyStride = 1024;
-inline double wall_key(int wall, int sub) { return -static_cast<double>(wall * kWallKeyStride + sub + 1); }
+inline double wall_key(int wall, int sub)
+{
+  return -static_cast<double>(wall * kWallKeyStride + sub + 1);
+}
 
 // A wall: one or two planes normal to an axis (lo below, hi above the grains), or a region of
 // the front end, named by its ID.
 enum class WallKind { xplane, yplane, zplane, region };
-template <>
-struct EnumNames<WallKind> {
+template <> struct EnumNames<WallKind> {
   static constexpr EnumName<WallKind> table[] = {{WallKind::xplane, "xplane"},
                                                  {WallKind::yplane, "yplane"},
                                                  {WallKind::zplane, "zplane"},
@@ -34,7 +36,7 @@ struct WallSpec {
   bool has_lo = false, has_hi = false;
   double lo = 0.0, hi = 0.0;
   std::string region_id;
-  int axis() const { return static_cast<int>(kind); }  // planes: 0 x, 1 y, 2 z
+  int axis() const { return static_cast<int>(kind); } // planes: 0 x, 1 y, 2 z
 };
 
 // A pair is a contact when its gap is below kContactMargin of the smaller radius, or when it
@@ -42,8 +44,7 @@ struct WallSpec {
 // step: SPOOK then brakes the approach before the spheres overlap. b == nullptr: a wall or a
 // fixed obstacle. n points from b (the wall) to a. A contact with a positive gap never pulls:
 // its impulse would be negative and the solve releases it.
-bool is_contact(const Body &a, const Body *b, const Vec3 &n, double gap, double h,
-                double damping);
+bool is_contact(const Body &a, const Body *b, const Vec3 &n, double gap, double h, double damping);
 
 // How far from a sphere a region wall is looked for: its radius, the margin, and its
 // free-flight reach over (damping + 1) steps, capped at the neighbour skin.
@@ -61,15 +62,15 @@ int plane_hits(const WallSpec &wall, const Body &b, double reach, PlaneHit hits[
 // One contact found by a front end, before the system is built.
 struct DetectedContact {
   Contact contact;
-  long long tag_a = 0;  // the tag of body a (the smaller tag of a pair)
-  double partner = 0;   // tag of body b or of an obstacle atom (> 0), or wall_key() (< 0)
-  int wall = -1;        // index of the wall, else -1
-  int store = -1;       // local atom that keeps the contact's warm start
-  double key = 0;       // the key under which `store` keeps it: the other side's tag or key
+  long long tag_a = 0; // the tag of body a (the smaller tag of a pair)
+  double partner = 0;  // tag of body b or of an obstacle atom (> 0), or wall_key() (< 0)
+  int wall = -1;       // index of the wall, else -1
+  int store = -1;      // local atom that keeps the contact's warm start
+  double key = 0;      // the key under which `store` keeps it: the other side's tag or key
 };
 
 // The one order of a step's contacts, independent of storage order and process count:
 // by tag_a, then partner, then gap.
 void sort_contacts(std::vector<DetectedContact> &found);
 
-}  // namespace fibre
+} // namespace fibre

@@ -52,8 +52,7 @@ class DistributedCholesky {
   // Solves with the rhs whose entries (global index, value) are summed over all ranks and
   // returns the solution at `wanted` (global indices, any order, repeats allowed).
   std::vector<double> solve(const std::vector<long> &rhs_index,
-                            const std::vector<double> &rhs_value,
-                            const std::vector<long> &wanted);
+                            const std::vector<double> &rhs_value, const std::vector<long> &wanted);
 
   long size() const { return n_; }
   bool factorized() const { return factorized_; }
@@ -84,4 +83,4 @@ Vector direct_solve(Form form, const ContactSystem &sys, const Exchange &ex, con
 // factors. `refinement` (optional) receives ||correction|| / ||dv*||.
 Vector refined_body_solution(const ContactSystem &sys, double *refinement = nullptr);
 
-}  // namespace fibre
+} // namespace fibre

@@ -48,9 +48,8 @@ class SerialExchange final : public Exchange {
 
 // Index of every local body (owned, then ghosts) in one global numbering of all owned bodies
 // of all processes; `total` receives their count. Uses exclusive_prefix_sum and forward.
-std::vector<long> global_body_index(const Exchange &ex, int num_owned, int num_bodies,
-                                    long &total);
+std::vector<long> global_body_index(const Exchange &ex, int num_owned, int num_bodies, long &total);
 
 const Exchange &serial_exchange();
 
-}  // namespace fibre
+} // namespace fibre

@@ -14,12 +14,11 @@
 namespace fibre {
 
 enum class EdgeWeight {
-  z,         // |z_a - z_b| (thesis)
-  straight,  // misalignment with the previous edge of the chain (prefers straight chains)
-  impulse,   // minus the last normal impulse (follows force chains)
+  z,        // |z_a - z_b| (thesis)
+  straight, // misalignment with the previous edge of the chain (prefers straight chains)
+  impulse,  // minus the last normal impulse (follows force chains)
 };
-template <>
-struct EnumNames<EdgeWeight> {
+template <> struct EnumNames<EdgeWeight> {
   static constexpr EnumName<EdgeWeight> table[] = {
       {EdgeWeight::z, "z"}, {EdgeWeight::straight, "straight"}, {EdgeWeight::impulse, "impulse"}};
 };
@@ -27,8 +26,8 @@ struct EnumNames<EdgeWeight> {
 struct FibreStats {
   int num_fibres = 0;
   int contacts_in_fibres = 0;
-  int num_contacts = 0;            // body-body contacts considered
-  std::vector<int> length_histogram;  // [k] = number of fibres with k contacts
+  int num_contacts = 0;              // body-body contacts considered
+  std::vector<int> length_histogram; // [k] = number of fibres with k contacts
   double covered_fraction() const
   {
     return num_contacts > 0 ? double(contacts_in_fibres) / num_contacts : 0.0;
@@ -40,10 +39,10 @@ struct FibreStats {
 // edges. Without ghosts, bodies >= num_owned_bodies() have no edges and contacts that touch
 // them are left out.
 struct ContactGraph {
-  std::vector<int> start;      // num_bodies + 1
-  std::vector<int> neighbour;  // the other body
-  std::vector<int> contact;    // the contact to it
-  int num_edges = 0;           // body-body contacts in the graph
+  std::vector<int> start;     // num_bodies + 1
+  std::vector<int> neighbour; // the other body
+  std::vector<int> contact;   // the contact to it
+  int num_edges = 0;          // body-body contacts in the graph
   int degree(int i) const { return start[i + 1] - start[i]; }
 };
 ContactGraph contact_graph(const ContactSystem &sys, bool include_ghosts);
@@ -71,7 +70,7 @@ struct Fibres {
   std::vector<int> contact_start{0};
   FibreStats stats;
   int num_fibres() const { return static_cast<int>(body_start.size()) - 1; }
-  int length(int f) const { return contact_start[f + 1] - contact_start[f]; }  // contacts
+  int length(int f) const { return contact_start[f + 1] - contact_start[f]; } // contacts
 };
 
 // Builds the fibres of `sys`. `impulses` (size num_contacts, normal impulse per contact) is
@@ -85,7 +84,6 @@ Fibres build_fibres(const ContactSystem &sys, EdgeWeight weight, const Vector *i
 double edge_weight(const ContactSystem &sys, EdgeWeight weight, const Vector *impulses, int c,
                    int from, const Vec3 &prev_dir);
 
-
 // Rooted spanning forest of the body graph: the fibres (built with the same weight), then the
 // remaining body-body contacts joining two different trees in increasing order of a static
 // weight (Kruskal; z for z and straight, -lambda_n for impulse; ties by contact index).
@@ -96,9 +94,9 @@ struct Forest {
   std::vector<int> parent;
   std::vector<int> parent_contact;
   int num_edges = 0;
-  FibreStats stats;  // trees with at least one contact, read as fibres: count, sizes, coverage
+  FibreStats stats; // trees with at least one contact, read as fibres: count, sizes, coverage
 };
 Forest build_forest(const ContactSystem &sys, EdgeWeight weight, const Vector *impulses,
                     bool include_ghosts);
 
-}  // namespace fibre
+} // namespace fibre

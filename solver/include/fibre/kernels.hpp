@@ -37,4 +37,4 @@ std::vector<Mat6> body_diagonal_blocks(const ContactSystem &sys);
 // Off-diagonal block K_ab = G_ca^T Sigma_c^-1 G_cb of a body-body contact c.
 Mat6 body_coupling_block(const ContactSystem &sys, int c);
 
-}  // namespace fibre
+} // namespace fibre

@@ -18,26 +18,26 @@ namespace fibre {
 // no extra operator application); after a restart it is the true residual.
 struct IterationRecord {
   int iteration = 0;
-  double rel_residual = 0;    // ||r|| / ||b||, operator inner product
-  double rel_residual_A = 0;  // ||r|| / ||A|| (thesis eq. 5.1) when norm_A > 0, else 0
+  double rel_residual = 0;   // ||r|| / ||b||, operator inner product
+  double rel_residual_A = 0; // ||r|| / ||A|| (thesis eq. 5.1) when norm_A > 0, else 0
   // ||r||_P / ||b||_P with ||r||_P^2 = r^T P^-1 r: the norm CR and MINRES minimise, hence
   // monotone for them (MINRES: its recurrence phibar; CR: r^T z; CG: r^T z).
   double rel_residual_P = 0;
-  double velocity_error = 0;  // from KrylovMonitor::velocity_error, else 0
+  double velocity_error = 0; // from KrylovMonitor::velocity_error, else 0
 };
 
 // Optional per-iteration recording.
 struct KrylovMonitor {
   bool record_history = false;
-  double norm_A = 0;  // the norm of A used for r_r (state which one where it is set)
-  std::function<double(const Vector &x)> velocity_error;  // e.g. v_e against MUMPS
+  double norm_A = 0; // the norm of A used for r_r (state which one where it is set)
+  std::function<double(const Vector &x)> velocity_error; // e.g. v_e against MUMPS
 };
 
 struct SolveResult {
   StopReason reason = StopReason::max_iterations;
   int iterations = 0;
-  double rel_residual = 0;  // final TRUE ||b - A x|| / ||b|| (inf when not finite)
-  int restarts = 0;         // restarts from the true residual (failed convergence checks)
+  double rel_residual = 0; // final TRUE ||b - A x|| / ||b|| (inf when not finite)
+  int restarts = 0;        // restarts from the true residual (failed convergence checks)
   std::vector<IterationRecord> history;
   bool converged() const { return reason == StopReason::converged; }
 };
@@ -53,7 +53,7 @@ struct SolveResult {
 // conjugate_residual: preconditioned CR, minimises ||r||_P over the Krylov space.
 // minres: Paige-Saunders MINRES with an SPD preconditioner, minimises ||r||_P as well.
 SolveResult cg(const LinearOperator &A, const Preconditioner &P, const Vector &b, Vector &x,
-                  const StopControl &stop, const KrylovMonitor *monitor = nullptr);
+               const StopControl &stop, const KrylovMonitor *monitor = nullptr);
 SolveResult conjugate_residual(const LinearOperator &A, const Preconditioner &P, const Vector &b,
                                Vector &x, const StopControl &stop,
                                const KrylovMonitor *monitor = nullptr);
@@ -64,4 +64,4 @@ SolveResult krylov_solve(Method m, const LinearOperator &A, const Preconditioner
                          const Vector &b, Vector &x, const StopControl &stop,
                          const KrylovMonitor *monitor = nullptr);
 
-}  // namespace fibre
+} // namespace fibre

@@ -9,18 +9,15 @@
 
 namespace fibre {
 
-template <class E>
-struct EnumName {
+template <class E> struct EnumName {
   E value;
   const char *name;
   bool alias = false;
 };
 
-template <class E>
-struct EnumNames;  // specialised next to each enum
+template <class E> struct EnumNames; // specialised next to each enum
 
-template <class E, class = decltype(EnumNames<E>::table)>
-const char *to_string(E value)
+template <class E, class = decltype(EnumNames<E>::table)> const char *to_string(E value)
 {
   for (const auto &entry : EnumNames<E>::table)
     if (entry.value == value) return entry.name;
@@ -39,8 +36,7 @@ bool parse(const std::string &text, E &value)
 }
 
 // "a|b|c": the names a user may type, aliases left out.
-template <class E, class = decltype(EnumNames<E>::table)>
-std::string choices()
+template <class E, class = decltype(EnumNames<E>::table)> std::string choices()
 {
   std::string out;
   for (const auto &entry : EnumNames<E>::table) {
@@ -51,4 +47,4 @@ std::string choices()
   return out;
 }
 
-}  // namespace fibre
+} // namespace fibre

@@ -12,8 +12,7 @@
 namespace fibre {
 
 enum class Form { contact, body };
-template <>
-struct EnumNames<Form> {
+template <> struct EnumNames<Form> {
   static constexpr EnumName<Form> table[] = {{Form::body, "body"}, {Form::contact, "contact"}};
 };
 
@@ -75,4 +74,4 @@ Vector body_from_lambda(const ContactSystem &sys, const Exchange &ex, const Vect
 std::unique_ptr<LinearOperator> make_operator(Form form, const ContactSystem &sys,
                                               const Exchange &ex);
 
-}  // namespace fibre
+} // namespace fibre

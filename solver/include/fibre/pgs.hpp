@@ -24,7 +24,7 @@ struct PgsControl {
 struct PgsResult {
   StopReason reason = StopReason::max_iterations;
   int sweeps = 0;
-  double last_change = 0;  // of the last sweep, relative to |lambda|
+  double last_change = 0; // of the last sweep, relative to |lambda|
   bool converged() const { return reason == StopReason::converged; }
 };
 
@@ -36,4 +36,4 @@ struct PgsResult {
 PgsResult pgs(const ContactSystem &sys, const Exchange &ex, const Cones &cones, const Vector &b,
               const std::vector<Vec6> &scale, Vector &lambda, const PgsControl &control);
 
-}  // namespace fibre
+} // namespace fibre

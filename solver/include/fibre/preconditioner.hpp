@@ -24,4 +24,4 @@ class IdentityPreconditioner final : public Preconditioner {
   std::string name() const override { return "none"; }
 };
 
-}  // namespace fibre
+} // namespace fibre

@@ -30,8 +30,7 @@ namespace fibre {
 // Fibres and forests use this process's contacts; contact-form chains may pass through ghost
 // bodies, body-form ones never do. apply() is not reentrant (it uses a work vector).
 enum class PrecondKind { none, jacobi, block, fibre, tree };
-template <>
-struct EnumNames<PrecondKind> {
+template <> struct EnumNames<PrecondKind> {
   static constexpr EnumName<PrecondKind> table[] = {{PrecondKind::none, "none"},
                                                     {PrecondKind::jacobi, "jacobi"},
                                                     {PrecondKind::block, "block"},
@@ -52,8 +51,7 @@ struct PrecondOptions {
 // every process must call this (the diagonal blocks take collective exchanges). Throws
 // std::runtime_error if a pivot block is not positive definite (non-finite input).
 std::unique_ptr<Preconditioner> make_preconditioner(Form form, const ContactSystem &sys,
-                                                    const Exchange &ex,
-                                                    const PrecondOptions &opt,
+                                                    const Exchange &ex, const PrecondOptions &opt,
                                                     FibreStats *stats = nullptr);
 
-}  // namespace fibre
+} // namespace fibre

@@ -18,7 +18,7 @@ struct Settings {
   StepOptions step{};
   ContactModel model{};
   std::vector<WallSpec> walls;
-  int export_every = 0;  // write the step's system every N steps (0: never)
+  int export_every = 0; // write the step's system every N steps (0: never)
   std::string export_prefix;
 };
 
@@ -35,4 +35,4 @@ Settings parse_settings(const std::vector<std::string> &args);
 // compliance rule.
 std::string describe(const Settings &s);
 
-}  // namespace fibre
+} // namespace fibre

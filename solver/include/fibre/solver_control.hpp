@@ -17,8 +17,7 @@ namespace fibre {
 //   direct  MUMPS;
 //   pgs     projected Gauss-Seidel on the nonsmooth problem alone (no linear pass).
 enum class Method { cg, cr, minres, direct, pgs };
-template <>
-struct EnumNames<Method> {
+template <> struct EnumNames<Method> {
   static constexpr EnumName<Method> table[] = {{Method::cg, "cg"},
                                                {Method::cr, "cr"},
                                                {Method::minres, "minres"},
@@ -27,7 +26,10 @@ struct EnumNames<Method> {
                                                {Method::cg, "uzawa", true},
                                                {Method::direct, "mumps", true}};
 };
-inline bool is_krylov(Method m) { return m == Method::cg || m == Method::cr || m == Method::minres; }
+inline bool is_krylov(Method m)
+{
+  return m == Method::cg || m == Method::cr || m == Method::minres;
+}
 
 // converged: the method's own test met its tolerance (Krylov: the TRUE relative residual,
 //   or StopControl::accept; PGS: a sweep moved lambda by at most tol relative to |lambda|).
@@ -40,12 +42,12 @@ inline bool is_krylov(Method m) { return m == Method::cg || m == Method::cr || m
 //   between (the attainable accuracy in floating point is above tol). PGS: the change per sweep
 //   stopped falling for kStagnationSweeps sweeps while above tol.
 enum class StopReason { converged, max_iterations, breakdown, non_finite, stagnation };
-template <>
-struct EnumNames<StopReason> {
-  static constexpr EnumName<StopReason> table[] = {
-      {StopReason::converged, "converged"},   {StopReason::max_iterations, "max_iterations"},
-      {StopReason::breakdown, "breakdown"},   {StopReason::non_finite, "non_finite"},
-      {StopReason::stagnation, "stagnation"}};
+template <> struct EnumNames<StopReason> {
+  static constexpr EnumName<StopReason> table[] = {{StopReason::converged, "converged"},
+                                                   {StopReason::max_iterations, "max_iterations"},
+                                                   {StopReason::breakdown, "breakdown"},
+                                                   {StopReason::non_finite, "non_finite"},
+                                                   {StopReason::stagnation, "stagnation"}};
 };
 inline constexpr int kMaxResidualChecks = 3;
 
@@ -60,4 +62,4 @@ struct StopControl {
   std::function<bool(int k, const Vector &x)> accept;
 };
 
-}  // namespace fibre
+} // namespace fibre

@@ -36,16 +36,16 @@
 namespace fibre {
 
 struct Spectrum {
-  std::vector<double> eigenvalues;  // descending: all (dense) or the Ritz values (Lanczos)
-  std::vector<double> residuals;    // Lanczos: residual bounds (infinite: not computed)
+  std::vector<double> eigenvalues; // descending: all (dense) or the Ritz values (Lanczos)
+  std::vector<double> residuals;   // Lanczos: residual bounds (infinite: not computed)
   double lambda_max = 0;
-  double lambda_min = 0;  // Lanczos: the smallest Ritz value (an upper bound)
-  int r = 0;              // eigenvalues[r] = lambda_r, the last above the largest gap
+  double lambda_min = 0; // Lanczos: the smallest Ritz value (an upper bound)
+  int r = 0;             // eigenvalues[r] = lambda_r, the last above the largest gap
   double lambda_r = 0;
-  double gap_ratio = 1;   // lambda_r / (next eigenvalue below it); 1 with no gap
-  double kappa = 1;       // lambda_max / lambda_min
-  double kappa_e = 1;     // lambda_max / lambda_r
-  int iterations = 0;     // Lanczos steps (0 for the dense paths)
+  double gap_ratio = 1; // lambda_r / (next eigenvalue below it); 1 with no gap
+  double kappa = 1;     // lambda_max / lambda_min
+  double kappa_e = 1;   // lambda_max / lambda_r
+  int iterations = 0;   // Lanczos steps (0 for the dense paths)
   // Lanczos: converged = lambda_1 and lambda_r met the tolerance and kappa_e repeated over
   // two checks; certified = besides, the Ritz values at the gap and at the
   // bottom settled and no unresolved stretch of the spectrum can hide a larger gap (or an
@@ -62,13 +62,13 @@ Spectrum effective_condition(std::vector<double> eigenvalues);
 Spectrum dense_spectrum(const LinearOperator &A, const Preconditioner &P);
 
 struct LanczosOptions {
-  int max_steps = 2000;     // also capped by the operator's global size
-  int check_every = 10;     // steps between convergence checks
-  double tol = 1e-4;        // relative residual of lambda_1 and lambda_r, and kappa_e drift
-  double gap_tol = 1e-2;    // relative residual of the Ritz values around the gap
-  bool certify = false;     // run until certified (may take about n steps without a gap)
+  int max_steps = 2000;  // also capped by the operator's global size
+  int check_every = 10;  // steps between convergence checks
+  double tol = 1e-4;     // relative residual of lambda_1 and lambda_r, and kappa_e drift
+  double gap_tol = 1e-2; // relative residual of the Ritz values around the gap
+  bool certify = false;  // run until certified (may take about n steps without a gap)
   std::uint64_t seed = 12345;
-  const Vector *start = nullptr;  // start vector (default: random; body form: ghosts zero)
+  const Vector *start = nullptr; // start vector (default: random; body form: ghosts zero)
 };
 
 Spectrum lanczos_spectrum(const LinearOperator &A, const Preconditioner &P,
@@ -82,4 +82,4 @@ Spectrum lanczos_spectrum(Form form, const ContactSystem &sys, const Exchange &e
 // std::invalid_argument unless Sigma is one value on every row.
 Spectrum body_space_spectrum(const ContactSystem &sys);
 
-}  // namespace fibre
+} // namespace fibre

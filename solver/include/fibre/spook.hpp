@@ -21,4 +21,4 @@ Vector spook_rhs(const ContactSystem &sys, const Vector *extra_dv = nullptr);
 // complete on owned bodies and ghosts. The one place this product is written.
 Vector velocity_change(const ContactSystem &sys, const Exchange &ex, const Vector &lambda);
 
-}  // namespace fibre
+} // namespace fibre

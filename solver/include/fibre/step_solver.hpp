@@ -27,7 +27,7 @@ struct StepOptions {
   // sweeps finish the step, only time.
   StopControl stop{1e-4, 200, {}};
   FrictionParams friction{};
-  int active_set_max = 1;  // K: passes of the active-set loop
+  int active_set_max = 1; // K: passes of the active-set loop
   // The loop has settled when the set stops changing and the capped impulses (mu l_n along
   // the slip direction, from the newest l_n) move by at most cap_tol * max |lambda|.
   double cap_tol = 1e-6;
@@ -49,27 +49,27 @@ std::string describe(const StepOptions &opt);
 
 // Counts (released, capped) are global over all processes; so are the Krylov figures.
 struct StepResult {
-  Vector lambda;          // final, feasible impulses (rows per contact)
-  Vector dv;              // velocity change from the contacts, M^-1 G^T lambda (owned bodies)
-  int iterations = 0;     // Krylov iterations of the last linear solve (0 for direct)
+  Vector lambda;      // final, feasible impulses (rows per contact)
+  Vector dv;          // velocity change from the contacts, M^-1 G^T lambda (owned bodies)
+  int iterations = 0; // Krylov iterations of the last linear solve (0 for direct)
   int total_iterations = 0;
-  double rel_residual = 0;  // of the last linear solve: true ||b - A x|| / ||b|| in its form
-  StopReason reason = StopReason::converged;  // first failed solve's reason, else converged
-  bool converged = true;    // every linear solve converged
-  int active_set_passes = 0;  // linear solves done (1 .. active_set_max)
-  bool set_settled = false;   // the active set and its caps settled (see cap_tol)
-  int released = 0;         // contacts with zero impulse at the end (lambda_n < 0)
-  int capped = 0;           // friction/rolling/twisting rows on their cone boundary
+  double rel_residual = 0; // of the last linear solve: true ||b - A x|| / ||b|| in its form
+  StopReason reason = StopReason::converged; // first failed solve's reason, else converged
+  bool converged = true;                     // every linear solve converged
+  int active_set_passes = 0;                 // linear solves done (1 .. active_set_max)
+  bool set_settled = false;                  // the active set and its caps settled (see cap_tol)
+  int released = 0;                          // contacts with zero impulse at the end (lambda_n < 0)
+  int capped = 0; // friction/rolling/twisting rows on their cone boundary
   // Relative residual of the contact conditions at the final lambda (see complementarity()
   // in contact_solver.cpp): 0 for an exact solution of the nonsmooth step.
   double complementarity = 0;
-  int sweeps = 0;  // projected Gauss-Seidel sweeps done after the loop
-  StopReason sweep_reason = StopReason::converged;  // of the sweeps (converged when none ran)
-  FibreStats fibres;        // of the last pass's preconditioner
-  double setup_seconds = 0;  // preconditioner builds
-  double solve_seconds = 0;  // linear solves (direct: analysis, factorization and solve)
-  double sweep_seconds = 0;  // projected Gauss-Seidel sweeps and the residuals around them
-  double total_seconds = 0;  // the whole call
+  int sweeps = 0; // projected Gauss-Seidel sweeps done after the loop
+  StopReason sweep_reason = StopReason::converged; // of the sweeps (converged when none ran)
+  FibreStats fibres;                               // of the last pass's preconditioner
+  double setup_seconds = 0;                        // preconditioner builds
+  double solve_seconds = 0; // linear solves (direct: analysis, factorization and solve)
+  double sweep_seconds = 0; // projected Gauss-Seidel sweeps and the residuals around them
+  double total_seconds = 0; // the whole call
 };
 
 // Solves the contact problem of `sys`. Its bodies must hold the step's velocities and
@@ -96,4 +96,4 @@ struct StepResult {
 StepResult solve_step(ContactSystem &sys, const Exchange &ex, const StepOptions &opt,
                       const Vector *warm, MPI_Comm comm);
 
-}  // namespace fibre
+} // namespace fibre

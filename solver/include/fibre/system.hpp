@@ -17,8 +17,8 @@ using Mat3 = Eigen::Matrix3d;
 using Mat6 = Eigen::Matrix<double, 6, 6>;
 using Vector = Eigen::VectorXd;
 
-inline constexpr int kBodyDofs = 6;  // (velocity, angular velocity)
-inline constexpr int kMaxRows = 6;   // rows per contact: n, t1, t2, twist, roll1, roll2
+inline constexpr int kBodyDofs = 6; // (velocity, angular velocity)
+inline constexpr int kMaxRows = 6;  // rows per contact: n, t1, t2, twist, roll1, roll2
 
 // A rigid sphere. Inertia is (2/5) m r^2 (solid sphere).
 struct Body {
@@ -27,20 +27,20 @@ struct Body {
   Vec3 x = Vec3::Zero();
   Vec3 v = Vec3::Zero();
   Vec3 omega = Vec3::Zero();
-  Vec3 force = Vec3::Zero();   // external force (gravity, other fixes), held over the step
-  Vec3 torque = Vec3::Zero();  // external torque
+  Vec3 force = Vec3::Zero();  // external force (gravity, other fixes), held over the step
+  Vec3 torque = Vec3::Zero(); // external torque
 };
 
 // One contact: body a against body b, or body a against a wall (b == -1).
 struct Contact {
   int a = -1;
-  int b = -1;                   // -1: wall
-  Vec3 normal = Vec3::UnitZ();  // unit, pointing from b (or the wall) to a
-  Vec3 t1 = Vec3::UnitX();      // tangent frame, orthonormal with normal
+  int b = -1;                  // -1: wall
+  Vec3 normal = Vec3::UnitZ(); // unit, pointing from b (or the wall) to a
+  Vec3 t1 = Vec3::UnitX();     // tangent frame, orthonormal with normal
   Vec3 t2 = Vec3::UnitY();
-  Vec3 point = Vec3::Zero();    // contact point
-  double gap = 0.0;             // signed distance, negative = overlap
-  std::array<double, kMaxRows> compliance{};  // per-row eps (1/stiffness)
+  Vec3 point = Vec3::Zero();                 // contact point
+  double gap = 0.0;                          // signed distance, negative = overlap
+  std::array<double, kMaxRows> compliance{}; // per-row eps (1/stiffness)
   bool is_wall() const { return b < 0; }
 };
 
@@ -58,15 +58,15 @@ Contact sphere_wall_contact(const std::vector<Body> &bodies, int a, const Vec3 &
 // (rows n, t1, t2); G_b the same with minus sign and rb. This is thesis eq. 2.1.1 written
 // with 15 numbers instead of two 6x6 blocks.
 struct ContactKinematics {
-  Mat3 frame;  // rows: n, t1, t2
-  Vec3 ra;     // p - x_a
-  Vec3 rb;     // p - x_b (unused for walls)
+  Mat3 frame; // rows: n, t1, t2
+  Vec3 ra;    // p - x_a
+  Vec3 rb;    // p - x_b (unused for walls)
 };
 
 // SPOOK parameters (doc/design.md section 2).
 struct SpookParams {
-  double h = 1e-3;       // time step
-  double damping = 2.0;  // d = tau / h, in steps (thesis uses tau = 2h)
+  double h = 1e-3;      // time step
+  double damping = 2.0; // d = tau / h, in steps (thesis uses tau = 2h)
   double upsilon() const { return 1.0 / (1.0 + 4.0 * damping); }
   // Sigma entry for compliance eps: 4 eps / (h^2 (1 + 4 d)).
   double sigma(double eps) const { return 4.0 * eps / (h * h * (1.0 + 4.0 * damping)); }
@@ -92,9 +92,9 @@ class ContactSystem {
   const std::vector<Body> &bodies() const { return bodies_; }
   const std::vector<Contact> &contacts() const { return contacts_; }
   const ContactKinematics &kinematics(int c) const { return kin_[c]; }
-  const Vector &inv_mass() const { return inv_mass_; }  // diagonal of M^-1, 6 per body
-  const Vector &mass() const { return mass_; }          // diagonal of M, 6 per body
-  const Vector &sigma() const { return sigma_; }        // diagonal of Sigma, rows per contact
+  const Vector &inv_mass() const { return inv_mass_; } // diagonal of M^-1, 6 per body
+  const Vector &mass() const { return mass_; }         // diagonal of M, 6 per body
+  const Vector &sigma() const { return sigma_; }       // diagonal of Sigma, rows per contact
   const Vector &rhs() const { return rhs_; }
   void set_rhs(const Vector &b) { rhs_ = b; }
 
@@ -108,7 +108,7 @@ class ContactSystem {
   // Active-set support: a masked row has a zero Jacobian row, Sigma 1 and rhs 0, so it is
   // decoupled (its lambda solves to 0) while every block structure stays intact.
   const std::vector<unsigned char> &row_mask() const { return mask_; }
-  void set_row_mask(const std::vector<unsigned char> &active);  // 1 = active row
+  void set_row_mask(const std::vector<unsigned char> &active); // 1 = active row
   bool row_active(Eigen::Index row) const { return mask_.empty() || mask_[row] != 0; }
 
  private:
@@ -120,14 +120,14 @@ class ContactSystem {
   std::vector<Body> bodies_;
   std::vector<Contact> contacts_;
   std::vector<ContactKinematics> kin_;
-  std::vector<unsigned char> mask_;  // empty = all rows active
+  std::vector<unsigned char> mask_; // empty = all rows active
   Vector inv_mass_;
   Vector mass_;
   Vector sigma_;
   Vector inv_sigma_;
-  Vector row_weight_;       // empty = all rows active
-  std::vector<int> pairs_;  // a, b per contact
+  Vector row_weight_;      // empty = all rows active
+  std::vector<int> pairs_; // a, b per contact
   Vector rhs_;
 };
 
-}  // namespace fibre
+} // namespace fibre

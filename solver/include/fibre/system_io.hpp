@@ -49,4 +49,4 @@ ContactSystem read_system_file(const std::string &path);
 // local system only. Throws std::runtime_error when a file cannot be written.
 void export_matrix_market(const ContactSystem &sys, const std::string &prefix);
 
-}  // namespace fibre
+} // namespace fibre
