@@ -15,9 +15,10 @@ double cone_coefficient(const FrictionParams &f, double r_eff, int cone)
   return (cone == 1 ? f.mu_twist : f.mu_roll) * r_eff;
 }
 
-void set_compliance(const ComplianceParams &p, double h, double m_min,
-                    const std::vector<Body> &bodies, std::vector<Contact> &contacts)
+void apply_contact_model(const ContactModel &model, double h, double m_min,
+                         const std::vector<Body> &bodies, std::vector<Contact> &contacts)
 {
+  const ComplianceParams &p = model.compliance;
   double eps_n = p.eps_n, eps_t = p.eps_t;
   if (p.automatic) eps_n = eps_t = p.factor * h * h / m_min;
   for (Contact &c : contacts) {
@@ -25,6 +26,7 @@ void set_compliance(const ComplianceParams &p, double h, double m_min,
     c.compliance[0] = eps_n;
     c.compliance[1] = c.compliance[2] = eps_t;
     for (int r = 3; r < kMaxRows; ++r) c.compliance[r] = eps_t / (reff * reff);
+    c.friction = model.friction;
   }
 }
 

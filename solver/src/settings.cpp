@@ -145,7 +145,7 @@ std::size_t read_model_keyword(const Reader &in, std::size_t i, Settings &s)
     const std::string e = "'" + key + " <non-negative number>'";
     const double v = in.number(i + 1, e);
     if (!(v >= 0.0)) Reader::illegal(e, &in.at(i + 1));
-    FrictionParams &f = s.step.friction;
+    FrictionParams &f = s.model.friction;
     (key == "mu" ? f.mu : key == "mu_roll" ? f.mu_roll : f.mu_twist) = v;
     return 2;
   }
@@ -190,7 +190,7 @@ Settings parse_settings(const std::vector<std::string> &args)
                       &key);
     i += used;
   }
-  const FrictionParams &f = s.step.friction;
+  const FrictionParams &f = s.model.friction;
   if (s.model.rows == 3 && (f.mu_roll > 0.0 || f.mu_twist > 0.0))
     throw SettingsError("mu_roll and mu_twist need 'rows 6' (rows 3 has no rotational rows)");
   return s;
@@ -205,7 +205,9 @@ std::string describe(const Settings &s)
     out += "auto (" + format_g(c.factor) + " dt^2 / m_min)";
   else
     out += format_g(c.eps_n) + " " + format_g(c.eps_t);
-  return out;
+  const FrictionParams &f = s.model.friction;
+  return out + ", mu " + format_g(f.mu) + ", mu_roll " + format_g(f.mu_roll) + ", mu_twist " +
+         format_g(f.mu_twist);
 }
 
 } // namespace fibre

@@ -18,8 +18,7 @@ std::string describe(const StepOptions &opt)
   return std::string("form ") + to_string(opt.form) + ", solver " + to_string(opt.solver) +
          ", precond " + to_string(opt.precond.kind) + ", weight " + to_string(opt.precond.weight) +
          ", tol " + g(opt.stop.tol) + ", pass_tol " + g(opt.pass_tol) + ", maxiter " +
-         std::to_string(opt.stop.max_iter) + ", mu " + g(opt.friction.mu) + ", mu_roll " +
-         g(opt.friction.mu_roll) + ", mu_twist " + g(opt.friction.mu_twist) + ", active_set " +
+         std::to_string(opt.stop.max_iter) + ", active_set " +
          std::to_string(opt.active_set_max) + ", sweeps " + std::to_string(opt.sweeps) +
          ", sweep_tol " + g(opt.sweep_tol);
 }
@@ -44,7 +43,7 @@ class StepSolver {
  public:
   StepSolver(ContactSystem &sys, const Exchange &ex, const StepOptions &opt, MPI_Comm comm)
       : sys_(sys), ex_(ex), opt_(opt), comm_(comm), rows_(sys.rows()), nc_(sys.num_contacts()),
-        cones_(sys, opt.friction), state_(nc_), all_rows_(sys.contact_dofs(), 1)
+        cones_(sys), state_(nc_), all_rows_(sys.contact_dofs(), 1)
   {
   }
 

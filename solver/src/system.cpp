@@ -107,6 +107,11 @@ void ContactSystem::compute_derived()
   }
 }
 
+void ContactSystem::set_friction(const FrictionParams &f)
+{
+  for (Contact &c : contacts_) c.friction = f;
+}
+
 void ContactSystem::set_row_mask(const std::vector<unsigned char> &active)
 {
   if (static_cast<Eigen::Index>(active.size()) != contact_dofs())

@@ -17,7 +17,8 @@ namespace {
 
 constexpr const char *kMagic = "fibre_contact_system";
 constexpr int kBodyFields = 17;
-constexpr int kContactFields = 2 + 12 + 1 + kMaxRows;
+constexpr int kContactFieldsV1 = 2 + 12 + 1 + kMaxRows;
+constexpr int kContactFields = kContactFieldsV1 + 3; // version 2: + mu, mu_roll, mu_twist
 // Unit vectors must read back as unit vectors; exported data are far more exact than this.
 constexpr double kUnitTol = 1e-6;
 
@@ -210,6 +211,10 @@ void write_system(std::ostream &out, const ContactSystem &sys)
       s += ' ';
       put_real(s, eps);
     }
+    for (double f : {c.friction.mu, c.friction.mu_roll, c.friction.mu_twist}) {
+      s += ' ';
+      put_real(s, f);
+    }
     s += '\n';
     out << s;
   }
@@ -244,9 +249,10 @@ ContactSystem parse_system(std::string_view text)
     in.fail(std::string("not a fibre_contact system file (expected '") + kMagic +
             " <version>', found '" + excerpt(t[0]) + "')");
   const long long version = in.integer(t[1], "format version");
-  if (version != kSystemFormatVersion)
-    in.fail("unsupported format version " + std::to_string(version) + " (this reader knows " +
+  if (version != 1 && version != kSystemFormatVersion)
+    in.fail("unsupported format version " + std::to_string(version) + " (this reader knows 1 and " +
             std::to_string(kSystemFormatVersion) + ")");
+  const int contact_fields = version == 1 ? kContactFieldsV1 : kContactFields;
 
   in.keyword(t, "rows", 1, "rows <3|6>");
   const long long rows = in.integer(t[1], "rows");
@@ -283,12 +289,12 @@ ContactSystem parse_system(std::string_view text)
   }
 
   in.keyword(t, "contacts", 1, "contacts <count>");
-  const int nc = in.count(t[1], "contact count", 2 * kContactFields);
+  const int nc = in.count(t[1], "contact count", 2 * contact_fields);
   std::vector<Contact> contacts(nc);
   for (int c = 0; c < nc; ++c) {
     const std::string what = "contact " + std::to_string(c);
     in.need(t, what + " of " + std::to_string(nc));
-    in.fields(t, kContactFields, what);
+    in.fields(t, contact_fields, what);
     Contact &k = contacts[c];
     const long long a = in.integer(t[0], what + " body a");
     const long long b = in.integer(t[1], what + " body b");
@@ -318,6 +324,13 @@ ContactSystem parse_system(std::string_view text)
         in.fail(what + ": compliance of row " + std::to_string(r) +
                 (r < rows ? " must be positive" : " must not be negative"));
       k.compliance[r] = eps;
+    }
+    if (version == 1) continue; // no coefficients stored: FrictionParams{}
+    double *coeff[3] = {&k.friction.mu, &k.friction.mu_roll, &k.friction.mu_twist};
+    const char *name[3] = {" mu", " mu_roll", " mu_twist"};
+    for (int i = 0; i < 3; ++i) {
+      *coeff[i] = in.real(t[kContactFieldsV1 + i], what + name[i]);
+      if (*coeff[i] < 0) in.fail(what + ":" + name[i] + " must not be negative");
     }
   }
 

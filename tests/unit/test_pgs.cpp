@@ -18,7 +18,6 @@ namespace {
 
 struct Problem {
   ContactSystem sys;
-  FrictionParams friction;
   Vector b;
 };
 
@@ -26,8 +25,8 @@ Problem pile(int n, double mu)
 {
   SceneParams p;
   p.seed = 11;
-  Problem pr{pile_scene(n, p), FrictionParams{}, Vector()};
-  pr.friction.mu = mu;
+  Problem pr{pile_scene(n, p), Vector()};
+  pr.sys.set_friction(FrictionParams{mu, 0.0, 0.0});
   pr.b = spook_rhs(pr.sys);
   return pr;
 }
@@ -41,11 +40,10 @@ TEST(Pgs, ConvergesToTheSettledDirectAnswer)
   ref_opt.solver = Method::direct;
   ref_opt.form = Form::contact;
   ref_opt.active_set_max = 60;
-  ref_opt.friction = pr.friction;
   const StepResult ref = solve_step(pr.sys, serial_exchange(), ref_opt, nullptr, MPI_COMM_SELF);
   ASSERT_TRUE(ref.set_settled);
 
-  const Cones cones(pr.sys, pr.friction);
+  const Cones cones(pr.sys);
   const std::vector<Vec6> scale = row_scales(pr.sys);
   Vector lambda = Vector::Zero(pr.sys.contact_dofs());
   const PgsResult res =
@@ -61,7 +59,7 @@ TEST(Pgs, ConvergesToTheSettledDirectAnswer)
 TEST(Pgs, TypedStopReasons)
 {
   Problem pr = pile(60, 0.4);
-  const Cones cones(pr.sys, pr.friction);
+  const Cones cones(pr.sys);
   const std::vector<Vec6> scale = row_scales(pr.sys);
   Vector lambda = Vector::Zero(pr.sys.contact_dofs());
   PgsResult res =
@@ -97,7 +95,6 @@ TEST(Pgs, AsTheStepSolver)
   Problem pr = pile(60, 0.4);
   StepOptions o;
   o.solver = Method::pgs;
-  o.friction = pr.friction;
   o.sweeps = 100000;
   o.sweep_tol = 1e-10;
   const StepResult res = solve_step(pr.sys, serial_exchange(), o, nullptr, MPI_COMM_SELF);

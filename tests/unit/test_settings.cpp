@@ -47,7 +47,7 @@ TEST(Settings, NoKeywordsKeepTheDefaults)
   EXPECT_EQ(d.active_set_max, 1);
   EXPECT_EQ(d.sweeps, 50);
   EXPECT_DOUBLE_EQ(d.sweep_tol, 1e-3);
-  EXPECT_DOUBLE_EQ(d.friction.mu, 0.5);
+  EXPECT_DOUBLE_EQ(s.model.friction.mu, 0.5);
   EXPECT_EQ(s.model.rows, 6);
   EXPECT_DOUBLE_EQ(s.model.damping, 2.0);
   EXPECT_TRUE(s.model.compliance.automatic);
@@ -56,8 +56,8 @@ TEST(Settings, NoKeywordsKeepTheDefaults)
   EXPECT_EQ(s.export_every, 0);
   EXPECT_EQ(describe(s),
             "form body, solver cg, precond tree, weight z, tol 0.0001, pass_tol 0.001, maxiter "
-            "200, mu 0.5, mu_roll 0, mu_twist 0, active_set 1, sweeps 50, sweep_tol 0.001, rows "
-            "6, damping 2, compliance auto (0.01 dt^2 / m_min)");
+            "200, active_set 1, sweeps 50, sweep_tol 0.001, rows 6, damping 2, compliance auto "
+            "(0.01 dt^2 / m_min), mu 0.5, mu_roll 0, mu_twist 0");
 }
 
 TEST(Settings, EveryKeywordSetsWhatItNames)
@@ -78,9 +78,9 @@ TEST(Settings, EveryKeywordSetsWhatItNames)
   EXPECT_DOUBLE_EQ(s.model.compliance.eps_n, 1e-7);
   EXPECT_DOUBLE_EQ(s.model.compliance.eps_t, 2e-7);
   EXPECT_DOUBLE_EQ(s.model.damping, 3.0);
-  EXPECT_DOUBLE_EQ(s.step.friction.mu, 0.3);
-  EXPECT_DOUBLE_EQ(s.step.friction.mu_roll, 0.1);
-  EXPECT_DOUBLE_EQ(s.step.friction.mu_twist, 0.05);
+  EXPECT_DOUBLE_EQ(s.model.friction.mu, 0.3);
+  EXPECT_DOUBLE_EQ(s.model.friction.mu_roll, 0.1);
+  EXPECT_DOUBLE_EQ(s.model.friction.mu_twist, 0.05);
   EXPECT_EQ(s.step.active_set_max, 4);
   EXPECT_EQ(s.step.sweeps, 9);
   EXPECT_DOUBLE_EQ(s.step.sweep_tol, 1e-4);

@@ -175,9 +175,8 @@ TEST(ContactSolver, PulledSphereSticksOrSlides)
     ContactSystem sys =
         make_system(bodies, {sphere_wall_contact(bodies, 0, Vec3::UnitZ(), r)}, cs.rows);
     ASSERT_NEAR(sys.contacts()[0].t1.x(), 1.0, 1e-15);
+    sys.set_friction(FrictionParams{mu, 1.0, 0.0});
     for (StepOptions o : all_options()) {
-      o.friction.mu = mu;
-      o.friction.mu_roll = 1.0;
       SCOPED_TRACE(label(o) + " rows " + std::to_string(cs.rows) + " pull " +
                    std::to_string(cs.pull));
       const StepResult res = solve(sys, o);
@@ -232,9 +231,8 @@ TEST(ContactSolver, ConservesMomentum)
     if (!c.is_wall()) internal.push_back(c);
   ASSERT_GT(internal.size(), 30u);
   ContactSystem sys(pile.bodies(), internal, 6, pile.params());
+  sys.set_friction(FrictionParams{0.5, 0.05, 0.05});
   for (StepOptions o : all_options()) {
-    o.friction.mu_roll = 0.05;
-    o.friction.mu_twist = 0.05;
     o.stop.tol = 1e-6; // conservation must not depend on the accuracy
     SCOPED_TRACE(label(o));
     const StepResult res = solve(sys, o);
@@ -264,10 +262,9 @@ TEST(ContactSolver, FeasibleAndConsistentOnPile)
   p.seed = 11;
   ContactSystem sys = pile_scene(80, p);
   const int rows = sys.rows();
+  const FrictionParams friction{0.4, 0.02, 0.02};
+  sys.set_friction(friction);
   for (StepOptions o : all_options()) {
-    o.friction.mu = 0.4;
-    o.friction.mu_roll = 0.02;
-    o.friction.mu_twist = 0.02;
     o.active_set_max = 60;
     SCOPED_TRACE(label(o));
     const StepResult res = solve(sys, o);
@@ -302,9 +299,9 @@ TEST(ContactSolver, FeasibleAndConsistentOnPile)
       const struct {
         int first, size;
         double radius;
-      } cones[3] = {{1, 2, o.friction.mu * ln},
-                    {3, 1, o.friction.mu_twist * r_eff * ln},
-                    {4, 2, o.friction.mu_roll * r_eff * ln}};
+      } cones[3] = {{1, 2, friction.mu * ln},
+                    {3, 1, friction.mu_twist * r_eff * ln},
+                    {4, 2, friction.mu_roll * r_eff * ln}};
       for (const auto &cone : cones) {
         const Vector t = res.lambda.segment(k + cone.first, cone.size);
         const Vector q = rho.segment(k + cone.first, cone.size);
@@ -383,8 +380,7 @@ TEST(ContactSolver, SweepsFinishAnUnsettledLoop)
   StepOptions ref_opt = base_options();
   ref_opt.solver = Method::direct;
   ref_opt.active_set_max = 60;
-  ref_opt.friction.mu = 0.4;
-  ref_opt.friction.mu_roll = 0.02;
+  sys.set_friction(FrictionParams{0.4, 0.02, 0.0});
   const StepResult ref = solve(sys, ref_opt);
   ASSERT_TRUE(ref.set_settled);
   EXPECT_LT(ref.complementarity, 1e-5);

@@ -31,6 +31,7 @@ ContactSystem sample_system(int rows = 6)
   bodies[1].torque = Vec3(1e300, -1.0 / 7.0, 3.0);
   std::vector<Contact> contacts = pile.contacts();
   contacts[0].compliance = {1e-8, 2e-8, 3e-8, 4e-8, 5e-8, 6e-8};
+  contacts[1].friction = FrictionParams{0.3, 1.0 / 3.0, 0.0}; // per contact since version 2
   ContactSystem sys(bodies, contacts, rows, p.spook, pile.num_bodies() - 4);
   std::vector<unsigned char> mask(sys.contact_dofs(), 1);
   for (std::size_t r = 2; r < mask.size(); r += 7) mask[r] = 0;
@@ -72,7 +73,9 @@ void expect_identical(const ContactSystem &a, const ContactSystem &b)
     const Contact &p = a.contacts()[c], &q = b.contacts()[c];
     EXPECT_TRUE(p.a == q.a && p.b == q.b && same3(p.normal, q.normal) && same3(p.t1, q.t1) &&
                 same3(p.t2, q.t2) && same3(p.point, q.point) && same(p.gap, q.gap) &&
-                p.compliance == q.compliance)
+                p.compliance == q.compliance && p.friction.mu == q.friction.mu &&
+                p.friction.mu_roll == q.friction.mu_roll &&
+                p.friction.mu_twist == q.friction.mu_twist)
         << "contact " << c;
   }
   EXPECT_EQ(a.row_mask(), b.row_mask());
@@ -143,11 +146,47 @@ TEST(SystemIo, RoundTripIsExact)
   for (int rows : {6, 3}) {
     const ContactSystem sys = sample_system(rows);
     const std::string text = to_text(sys);
-    EXPECT_EQ(text.rfind("fibre_contact_system 1\n", 0), 0u);
+    EXPECT_EQ(text.rfind("fibre_contact_system 2\n", 0), 0u);
     const ContactSystem back = parse_system(text);
     expect_identical(sys, back);
     EXPECT_EQ(to_text(back), text); // and the writer is deterministic
   }
+}
+
+// Version 1 files (no friction per contact) still read, with the default coefficients; a
+// negative coefficient is an error.
+TEST(SystemIo, VersionOneAndFrictionFields)
+{
+  const ContactSystem sys = sample_system();
+  std::string text = to_text(sys);
+  // drop the three coefficients of every contact line and call it version 1
+  std::istringstream in(text);
+  std::string v1, line;
+  bool in_contacts = false;
+  int left = 0;
+  while (std::getline(in, line)) {
+    if (line.rfind("contacts ", 0) == 0) {
+      in_contacts = true;
+      left = sys.num_contacts();
+    } else if (in_contacts && left > 0) {
+      line = line.substr(0, line.rfind(' '));
+      line = line.substr(0, line.rfind(' '));
+      line = line.substr(0, line.rfind(' '));
+      --left;
+    }
+    v1 += line + "\n";
+  }
+  v1.replace(0, std::string("fibre_contact_system 2").size(), "fibre_contact_system 1");
+  const ContactSystem old = parse_system(v1);
+  ASSERT_EQ(old.num_contacts(), sys.num_contacts());
+  EXPECT_EQ(old.contacts()[1].friction.mu, FrictionParams{}.mu);
+  EXPECT_EQ(old.contacts()[1].friction.mu_roll, FrictionParams{}.mu_roll);
+  EXPECT_EQ(old.contacts()[0].compliance, sys.contacts()[0].compliance);
+  // a version-2 contact line with a negative coefficient
+  const std::size_t at = text.find("contacts ");
+  const std::size_t end = text.find('\n', text.find('\n', at) + 1);
+  text.replace(end - 1, 1, "-1");
+  expect_error(text, {"contact 0:", "mu_twist must not be negative"});
 }
 
 TEST(SystemIo, FileRoundTripAndMissingFile)
@@ -193,7 +232,7 @@ TEST(SystemIo, EachMalformedInputGetsItsOwnError)
 
   expect_error("", {"line 1:", "unexpected end of input", "header"});
   expect_error(edit(0, "fibre_contact_sistem 1"), {"line 1:", "not a fibre_contact system"});
-  expect_error(edit(0, "fibre_contact_system 2"), {"unsupported format version 2"});
+  expect_error(edit(0, "fibre_contact_system 3"), {"unsupported format version 3"});
   expect_error(edit(0, "fibre_contact_system one"), {"'one' is not an integer"});
   expect_error(edit(2, "rows 4"), {"rows must be 3 or 6"});
   expect_error(edit(3, "spook 0 2"), {"time step h must be positive"});
@@ -210,7 +249,7 @@ TEST(SystemIo, EachMalformedInputGetsItsOwnError)
     const std::string cut = join(std::vector<std::string>(L.begin(), L.begin() + last)) +
                             L[last].substr(0, L[last].size() / 2);
     expect_error(cut, {line_tag(last), "contact " + std::to_string(sys.num_contacts() - 1) +
-                                           ": expected 21 values"});
+                                           ": expected 24 values"});
     expect_error(text.substr(0, text.size() - 4), {"unexpected end of input", "'end'"});
     std::vector<std::string> early(L.begin(), L.begin() + bodies + 3);
     expect_error(join(early), {line_tag(bodies), "body count 25 is more than the rest"});
@@ -253,7 +292,7 @@ TEST(SystemIo, EachMalformedInputGetsItsOwnError)
   expect_error(edit(contacts + 1, with_token(c0, 2, "2")), {"contact 0 normal is not a unit"});
   expect_error(edit(contacts + 1, with_token(c0, 15, "0")),
                {"contact 0: compliance of row 0 must be positive"});
-  expect_error(edit(contacts + 1, c0 + " 7"), {"contact 0: expected 21 values, found 22"});
+  expect_error(edit(contacts + 1, c0 + " 7"), {"contact 0: expected 24 values, found 25"});
 
   // Anything after the end, and binary junk.
   expect_error(text + "bodies 1 1\n", {"unexpected content after 'end'"});

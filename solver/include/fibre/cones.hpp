@@ -40,7 +40,7 @@ inline void set_cone(Vector &v, Eigen::Index base, const Cone &cone, const Eigen
 // contact and cone, and the projection.
 class Cones {
  public:
-  Cones(const ContactSystem &sys, const FrictionParams &friction);
+  explicit Cones(const ContactSystem &sys); // coefficients from each contact's friction
   int rows() const { return rows_; }
   double coeff(int c, int k) const { return coeff_[3 * std::size_t(c) + k]; }
   // lambda_n >= 0 and every cone (radius from the projected normal impulse); l points to

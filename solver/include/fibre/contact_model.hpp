@@ -8,14 +8,6 @@
 
 namespace fibre {
 
-// A zero coefficient means no resistance: those rows never enter the solve and carry no
-// impulse.
-struct FrictionParams {
-  double mu = 0.5;       // Coulomb: |lambda_t| <= mu lambda_n
-  double mu_roll = 0.0;  // rolling: |lambda_roll| <= mu_roll r_eff lambda_n
-  double mu_twist = 0.0; // twisting: |lambda_twist| <= mu_twist r_eff lambda_n
-};
-
 // How stiff the rows are. auto: eps = factor dt^2 / m_min on every translational row, so that
 // Sigma is a fixed small fraction of the lightest body's G M^-1 G^T entry whatever the step.
 // fixed: eps_n on the normal row, eps_t on the tangential rows. The rotational rows take
@@ -31,7 +23,7 @@ struct ContactModel {
   int rows = 6;         // 3: translational rows only; 6: with twisting and rolling
   double damping = 2.0; // SPOOK d = tau / h, in steps
   ComplianceParams compliance{};
-  FrictionParams friction{};
+  FrictionParams friction{}; // of every contact (one material)
 };
 
 // r_eff = ra rb / (ra + rb) for a pair, ra against a wall (b == nullptr).
@@ -44,9 +36,9 @@ double effective_radius(const std::vector<Body> &bodies, const Contact &c);
 // Cone radius per unit normal impulse of cone k (0 Coulomb, 1 twisting, 2 rolling).
 double cone_coefficient(const FrictionParams &f, double r_eff, int cone);
 
-// Sets the per-row compliance of every contact (m_min: the lightest body of the simulation,
-// read in automatic mode only).
-void set_compliance(const ComplianceParams &p, double h, double m_min,
-                    const std::vector<Body> &bodies, std::vector<Contact> &contacts);
+// Sets the per-row compliance and the friction coefficients of every contact (m_min: the
+// lightest body of the simulation, read by automatic compliance only).
+void apply_contact_model(const ContactModel &model, double h, double m_min,
+                         const std::vector<Body> &bodies, std::vector<Contact> &contacts);
 
 } // namespace fibre

@@ -31,8 +31,8 @@ class SettingsError : public std::runtime_error {
 // The keywords after "fix ID group fibre_contact". Throws SettingsError.
 Settings parse_settings(const std::vector<std::string> &args);
 
-// One line for the log: the step's options (describe(StepOptions)), rows, damping and the
-// compliance rule.
+// One line for the log: the step's options (describe(StepOptions)), rows, damping, the
+// compliance rule and the friction coefficients.
 std::string describe(const Settings &s);
 
 } // namespace fibre

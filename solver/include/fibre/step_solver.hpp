@@ -26,7 +26,6 @@ struct StepOptions {
   // The last (tight) linear pass solves to tol: tighter solves bought no accuracy once the
   // sweeps finish the step, only time.
   StopControl stop{1e-4, 200, {}};
-  FrictionParams friction{};
   int active_set_max = 1; // K: passes of the active-set loop
   // The loop has settled when the set stops changing and the capped impulses (mu l_n along
   // the slip direction, from the newest l_n) move by at most cap_tol * max |lambda|.

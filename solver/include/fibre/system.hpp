@@ -31,6 +31,15 @@ struct Body {
   Vec3 torque = Vec3::Zero(); // external torque
 };
 
+// The friction, rolling and twisting coefficients of one contact. A zero coefficient means no
+// resistance: those rows carry no impulse. r_eff = ra rb / (ra + rb) for a pair, ra against a
+// wall.
+struct FrictionParams {
+  double mu = 0.5;       // Coulomb: |lambda_t| <= mu lambda_n
+  double mu_roll = 0.0;  // rolling: |lambda_roll| <= mu_roll r_eff lambda_n
+  double mu_twist = 0.0; // twisting: |lambda_twist| <= mu_twist r_eff lambda_n
+};
+
 // One contact: body a against body b, or body a against a wall (b == -1).
 struct Contact {
   int a = -1;
@@ -41,6 +50,7 @@ struct Contact {
   Vec3 point = Vec3::Zero();                 // contact point
   double gap = 0.0;                          // signed distance, negative = overlap
   std::array<double, kMaxRows> compliance{}; // per-row eps (1/stiffness)
+  FrictionParams friction{};
   bool is_wall() const { return b < 0; }
 };
 
@@ -97,6 +107,9 @@ class ContactSystem {
   const Vector &sigma() const { return sigma_; }       // diagonal of Sigma, rows per contact
   const Vector &rhs() const { return rhs_; }
   void set_rhs(const Vector &b) { rhs_ = b; }
+  // The coefficients of contact c, or of every contact (they enter no derived quantity).
+  void set_friction(int c, const FrictionParams &f) { contacts_[c].friction = f; }
+  void set_friction(const FrictionParams &f);
 
   // Flat data for the matrix-free kernels (derived, kept in step with contacts and mask):
   // the two bodies of every contact (a, b; b = -1 for walls) as 2 ints per contact, 1 / Sigma

@@ -32,7 +32,7 @@
 
 namespace fibre {
 
-inline constexpr int kSystemFormatVersion = 1;
+inline constexpr int kSystemFormatVersion = 2; // 2: friction per contact; 1 is read too
 
 void write_system(std::ostream &out, const ContactSystem &sys);
 // Throws std::runtime_error when the file cannot be written.
