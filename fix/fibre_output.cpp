@@ -112,7 +112,7 @@ void FibreOutput::fill_local(const std::vector<fibre::DetectedContact> &found,
 
 void FibreOutput::export_step(const std::string &prefix, const fibre::ContactSystem &sys,
                               const std::vector<fibre::DetectedContact> &found,
-                              const fibre::Vector *lambda)
+                              const fibre::Vector *lambda, const fibre::Vector &warm)
 {
   const std::string base = prefix + "." +
                            std::to_string(static_cast<long long>(update->ntimestep)) + "." +
@@ -128,14 +128,17 @@ void FibreOutput::export_step(const std::string &prefix, const fibre::ContactSys
   const int rows = sys.rows();
   std::fprintf(fp, "# fibre_contact impulses, step %lld, process %d: %d contacts, %d rows each\n",
                static_cast<long long>(update->ntimestep), comm->me, sys.num_contacts(), rows);
-  std::fprintf(fp, "# contact tag_a tag_b(0 = wall) wall(0 = none) lambda_0 .. lambda_%d\n",
-               rows - 1);
+  std::fprintf(fp,
+               "# contact tag_a tag_b(0 = wall) wall(0 = none) lambda_0 .. lambda_%d warm_0 .. "
+               "warm_%d\n",
+               rows - 1, rows - 1);
   for (int c = 0; c < sys.num_contacts(); ++c) {
     const fibre::DetectedContact &fc = found[c];
     std::fprintf(fp, "%d %lld %lld %d", c, static_cast<long long>(fc.tag_a),
                  static_cast<long long>(fc.partner > 0 ? fc.partner : 0.0), fc.wall + 1);
-    for (int r = 0; r < rows; ++r)
-      std::fprintf(fp, " %.17g", lambda ? (*lambda)[Eigen::Index(rows) * c + r] : 0.0);
+    const Eigen::Index at = Eigen::Index(rows) * c;
+    for (int r = 0; r < rows; ++r) std::fprintf(fp, " %.17g", lambda ? (*lambda)[at + r] : 0.0);
+    for (int r = 0; r < rows; ++r) std::fprintf(fp, " %.17g", warm.size() > at + r ? warm[at + r] : 0.0);
     std::fprintf(fp, "\n");
   }
   std::fclose(fp);

@@ -51,9 +51,11 @@ class FibreOutput : protected LAMMPS_NS::Pointers {
   // One row per contact: tags, wall, gap, |normal|, |friction|, |rolling|, |twisting| impulse.
   void fill_local(const std::vector<fibre::DetectedContact> &found, const fibre::Vector *lambda,
                   int rows, double **&array_local, int &size_local_rows);
-  // prefix.STEP.RANK.sys (the system) and .lambda (the impulses with the atoms of every contact).
+  // prefix.STEP.RANK.sys (the system) and .lambda (the atoms of every contact, its impulses and
+  // the warm start the solve began from): together the whole step, to replay it.
   void export_step(const std::string &prefix, const fibre::ContactSystem &sys,
-                   const std::vector<fibre::DetectedContact> &found, const fibre::Vector *lambda);
+                   const std::vector<fibre::DetectedContact> &found, const fibre::Vector *lambda,
+                   const fibre::Vector &warm);
 
   void write_restart(FILE *fp) const;
   void read_restart(const char *buf);

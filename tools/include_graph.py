@@ -18,8 +18,8 @@ LAYERS = {
     1: ["contact_model", "kernels", "detection", "contact_history"],
     2: ["spook", "operators", "fibres", "cones", "assembly", "system_io"],
     3: ["solver_control", "preconditioner", "preconditioner_family", "krylov", "direct", "pgs",
-        "spectra", "analysis", "combined_preconditioner"],
-    4: ["step_solver"],
+        "spectra", "analysis", "combined_preconditioner", "nonsmooth_reference"],
+    4: ["step_solver", "accuracy_study"],
     5: ["settings"],
 }
 FRONT_END = 6
