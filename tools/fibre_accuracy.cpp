@@ -106,8 +106,8 @@ void print_row(const char *name, const StudyRow &r, std::FILE *csv)
   if (csv)
     std::fprintf(csv, "\"%s\",%.6g,%.6g,%d,%d,%d,%.6g,%d,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g\n", name,
                  r.seconds, r.k_products, r.iterations, r.passes, r.sweeps, r.complementarity,
-                 r.converged ? 1 : 0, e.dv_trans, e.dv_rot, e.lambda_n, e.lambda_t,
-                 e.lambda_roll, e.lambda_twist);
+                 r.converged ? 1 : 0, e.dv_trans, e.dv_rot, e.lambda_n, e.lambda_t, e.lambda_roll,
+                 e.lambda_twist);
 }
 
 int run(const Options &opt)
@@ -123,9 +123,8 @@ int run(const Options &opt)
               "Newton %d iterations, residual %.2e%s\n",
               seconds_since(t0), ref.sweeps, ref.complementarity_pgs, ref.newton.iterations,
               ref.newton.complementarity, ref.newton.converged ? "" : " (not converged)");
-  std::printf("the two agree to %.2e in velocity, %.2e in impulses: %s\n",
-              ref.agreement.velocity(), ref.agreement.impulse(),
-              ref.confirmed() ? "confirmed" : "NOT confirmed");
+  std::printf("the two agree to %.2e in velocity, %.2e in impulses: %s\n", ref.agreement.velocity(),
+              ref.agreement.impulse(), ref.confirmed() ? "confirmed" : "NOT confirmed");
   const double tk = k_product_seconds(sys);
   std::printf("one K product: %.3g s\n\n", tk);
   std::printf("%-50s %9s %8s %6s %6s %9s %9s %9s %9s %9s %9s %9s\n", "setting", "seconds",
@@ -140,6 +139,8 @@ int run(const Options &opt)
   run_row.setting = "the run's own solve (export)";
   run_row.error = step_accuracy(sys, state.lambda, ref.lambda);
   print_row("(the run's own impulses)", run_row, nullptr);
+  run_row.error = step_accuracy(sys, state.warm, ref.lambda);
+  print_row("(the warm start alone)", run_row, nullptr);
   for (const std::string &text : opt.settings) {
     const Settings s = parse_settings(words(text));
     const StudyRow row = measure_setting(state, s.step, ref.lambda, tk, opt.repeat);

@@ -46,8 +46,8 @@ StepState read_step_state(const std::string &prefix)
     ++seen;
   }
   if (seen != nc)
-    throw std::runtime_error(prefix + ".lambda: " + std::to_string(seen) + " contacts, the system has " +
-                             std::to_string(nc));
+    throw std::runtime_error(prefix + ".lambda: " + std::to_string(seen) +
+                             " contacts, the system has " + std::to_string(nc));
   return st;
 }
 

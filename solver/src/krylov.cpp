@@ -349,6 +349,7 @@ SolveResult krylov_solve(Method m, const LinearOperator &A, const Preconditioner
     return minres(A, P, b, x, stop, monitor);
   case Method::direct:
   case Method::pgs:
+  case Method::nncg:
     break;
   }
   throw std::invalid_argument(std::string("krylov_solve: ") + to_string(m) +

@@ -20,7 +20,10 @@ double rel(double err2, double ref2)
 }
 
 // Row group of row r of a contact: 0 normal, 1 Coulomb, 2 twisting, 3 rolling.
-int group_of(int r) { return r == 0 ? 0 : r < 3 ? 1 : r == 3 ? 2 : 3; }
+int group_of(int r)
+{
+  return r == 0 ? 0 : r < 3 ? 1 : r == 3 ? 2 : 3;
+}
 
 // P(z) and its generalized Jacobian, one rows x rows block per contact.
 void project_with_jacobian(const Cones &cones, const Vector &z, Vector &p,
@@ -43,7 +46,8 @@ void project_with_jacobian(const Cones &cones, const Vector &z, Vector &p,
       const Eigen::Vector2d t = cone_values(z, at, cone);
       const double tn = cone.size == 2 ? t.norm() : std::abs(t[0]);
       if (tn <= radius) { // sticking: P = identity on the cone
-        for (int i = 0; i < cone.size; ++i) jp.emplace_back(at + cone.first + i, at + cone.first + i, 1.0);
+        for (int i = 0; i < cone.size; ++i)
+          jp.emplace_back(at + cone.first + i, at + cone.first + i, 1.0);
         continue;
       }
       // sliding: P = radius t / |t|
@@ -98,13 +102,16 @@ StepAccuracy step_accuracy(const ContactSystem &sys, const Vector &lambda, const
     g[k][0] += (lambda[i] - ref[i]) * (lambda[i] - ref[i]);
     g[k][1] += ref[i] * ref[i];
   }
+  // A group whose reference is (numerically) empty, such as twisting with mu_twist 0, is
+  // measured against the normal impulses instead of against its own round-off.
+  const double floor2 = 1e-24 * g[0][1];
   StepAccuracy a;
   a.dv_trans = rel(e[0][0], e[0][1]);
-  a.dv_rot = rel(e[1][0], e[1][1]);
+  a.dv_rot = rel(e[1][0], std::max(e[1][1], 1e-24 * e[0][1]));
   a.lambda_n = rel(g[0][0], g[0][1]);
-  a.lambda_t = rel(g[1][0], g[1][1]);
-  a.lambda_twist = rel(g[2][0], g[2][1]);
-  a.lambda_roll = rel(g[3][0], g[3][1]);
+  a.lambda_t = rel(g[1][0], std::max(g[1][1], floor2));
+  a.lambda_twist = rel(g[2][0], std::max(g[2][1], floor2));
+  a.lambda_roll = rel(g[3][0], std::max(g[3][1], floor2));
   return a;
 }
 
@@ -171,14 +178,18 @@ Reference nonsmooth_reference(const ContactSystem &sys, const Vector &start,
   for (int c = 0; c < sys.num_contacts(); ++c) cones.project(pgs_lambda.data() + sys.rows() * c, c);
   // sweeps in rounds, until the residual (not only the change per sweep) meets the target
   while (ref.sweeps < opt.max_sweeps) {
-    const PgsResult r = pgs(sys, serial_exchange(), cones, b, scale, pgs_lambda,
-                            PgsControl{std::min(2000, opt.max_sweeps - ref.sweeps), 1e-15, 1 << 30});
+    const PgsResult r =
+        pgs(sys, serial_exchange(), cones, b, scale, pgs_lambda,
+            PgsControl{std::min(2000, opt.max_sweeps - ref.sweeps), 1e-15, 1 << 30});
     ref.sweeps += r.sweeps;
     ref.complementarity_pgs = complementarity(sys, serial_exchange(), cones, b, pgs_lambda, scale);
     if (ref.complementarity_pgs <= opt.target || r.reason == StopReason::non_finite) break;
   }
   Vector newton_lambda = start;
   ref.newton = semismooth_newton(sys, cones, b, newton_lambda, opt.target, opt.max_newton);
+  // Newton's iterate is feasible only in the limit: its projection is the answer
+  for (int c = 0; c < sys.num_contacts(); ++c)
+    cones.project(newton_lambda.data() + sys.rows() * c, c);
   ref.agreement = step_accuracy(sys, pgs_lambda, newton_lambda);
   ref.lambda = ref.newton.converged ? newton_lambda : pgs_lambda;
   return ref;

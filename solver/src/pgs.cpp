@@ -21,6 +21,8 @@ PgsResult pgs(const ContactSystem &sys, const Exchange &ex, const Cones &cones, 
   Vector dv_start, moved, lambda_start; // reused by every sweep
   double best = INFINITY;
   int since_best = 0;
+  Vector direction, change; // nonlinear CG
+  double last_change2 = 0;
   for (int s = 0; s < control.max_sweeps; ++s) {
     // dv follows this process's updates; `moved` collects them for the other processes.
     dv_start = dv;
@@ -58,19 +60,34 @@ PgsResult pgs(const ContactSystem &sys, const Exchange &ex, const Cones &cones, 
       return res;
     }
     res.last_change = norms[1] > 0 ? std::sqrt(norms[0] / norms[1]) : 0.0;
+    res.reason = StopReason::max_iterations;
     if (!(norms[0] > control.tol * control.tol * norms[1])) {
       res.reason = StopReason::converged;
-      return res;
+      break;
     }
     if (res.last_change < best) {
       best = res.last_change;
       since_best = 0;
     } else if (++since_best >= control.stall_sweeps) {
       res.reason = StopReason::stagnation;
-      return res;
+      break;
+    }
+    if (control.nonlinear_cg && s + 1 < control.max_sweeps) {
+      change = lambda - lambda_start;
+      const double beta = s > 0 ? norms[0] / last_change2 : 2.0;
+      last_change2 = norms[0];
+      if (beta > 1.0) {
+        direction = change; // restart
+      } else {
+        direction *= beta;
+        lambda += direction;
+        dv += velocity_change(sys, ex, direction);
+        direction += change;
+      }
     }
   }
-  res.reason = StopReason::max_iterations;
+  if (control.nonlinear_cg) // the last step along the direction may have left the cones
+    for (int c = 0; c < nc; ++c) cones.project(lambda.data() + Eigen::Index(rows) * c, c);
   return res;
 }
 

@@ -114,7 +114,11 @@ std::size_t read_solver_keyword(const Reader &in, std::size_t i, StepOptions &op
     opt.sweeps = static_cast<int>(in.integer(i + 1, "'sweeps <non-negative integer>'", 0, 100000));
   else if (key == "sweep_tol")
     opt.sweep_tol = in.positive(i + 1, "'sweep_tol <positive number>'");
-  else
+  else if (key == "sweep_cg") {
+    if (!in.has(i + 1) || (in.at(i + 1) != "yes" && in.at(i + 1) != "no"))
+      Reader::illegal("'sweep_cg yes|no'", in.has(i + 1) ? &in.at(i + 1) : nullptr);
+    opt.sweep_cg = in.at(i + 1) == "yes";
+  } else
     return 0;
   return 2;
 }
@@ -186,7 +190,7 @@ Settings parse_settings(const std::vector<std::string> &args)
     if (!used)
       Reader::illegal("a keyword (form, solver, precond, weight, tol, pass_tol, maxiter, "
                       "compliance, damping, mu, mu_roll, mu_twist, rows, active_set, sweeps, "
-                      "sweep_tol, wall, export)",
+                      "sweep_tol, sweep_cg, wall, export)",
                       &key);
     i += used;
   }

@@ -18,9 +18,9 @@ std::string describe(const StepOptions &opt)
   return std::string("form ") + to_string(opt.form) + ", solver " + to_string(opt.solver) +
          ", precond " + to_string(opt.precond.kind) + ", weight " + to_string(opt.precond.weight) +
          ", tol " + g(opt.stop.tol) + ", pass_tol " + g(opt.pass_tol) + ", maxiter " +
-         std::to_string(opt.stop.max_iter) + ", active_set " +
-         std::to_string(opt.active_set_max) + ", sweeps " + std::to_string(opt.sweeps) +
-         ", sweep_tol " + g(opt.sweep_tol);
+         std::to_string(opt.stop.max_iter) + ", active_set " + std::to_string(opt.active_set_max) +
+         ", sweeps " + std::to_string(opt.sweeps) + ", sweep_tol " + g(opt.sweep_tol) +
+         (opt.sweep_cg ? ", sweep_cg yes" : "");
 }
 
 namespace {
@@ -54,6 +54,7 @@ class StepSolver {
   void active_set_loop(Vector &lambda, StepResult &res);
 
   double coeff(int c, int k) const { return cones_.coeff(c, k); }
+  bool sweeps_only() const { return opt_.solver == Method::pgs || opt_.solver == Method::nncg; }
   Eigen::Index base(int c) const { return Eigen::Index(rows_) * c; }
   std::vector<unsigned char> active_mask() const;
   Vector fixed_impulses(const Vector &lambda) const;
@@ -267,8 +268,9 @@ void StepSolver::finish(Vector &lambda, StepResult &res) const
   const std::vector<Vec6> scale = row_scales(sys_);
   res.complementarity = complementarity(sys_, ex_, cones_, b_full_, lambda, scale);
   if (opt_.sweeps > 0 && res.complementarity > opt_.sweep_tol) {
-    const PgsResult pr =
-        pgs(sys_, ex_, cones_, b_full_, scale, lambda, PgsControl{opt_.sweeps, opt_.sweep_tol});
+    PgsControl control{opt_.sweeps, opt_.sweep_tol};
+    control.nonlinear_cg = opt_.sweep_cg || opt_.solver == Method::nncg;
+    const PgsResult pr = pgs(sys_, ex_, cones_, b_full_, scale, lambda, control);
     res.sweeps = pr.sweeps;
     res.sweep_reason = pr.reason;
     res.complementarity = complementarity(sys_, ex_, cones_, b_full_, lambda, scale);
@@ -308,7 +310,7 @@ Vector StepSolver::initial_impulses(const Vector *warm)
   const bool warm_ok = warm && warm->size() == n && warm->allFinite();
   const bool use_warm = ex_.max(warm_ok ? 0.0 : 1.0) == 0.0;
   Vector lambda = use_warm ? *warm : Vector::Zero(n);
-  if (use_warm && opt_.solver != Method::pgs) update_set(lambda, std::vector<unsigned char>(n, 0));
+  if (use_warm && !sweeps_only()) update_set(lambda, std::vector<unsigned char>(n, 0));
   return lambda;
 }
 
@@ -370,13 +372,13 @@ StepResult StepSolver::run(const Vector *warm)
   sys_.set_row_mask(all_rows_);
   b_full_ = spook_rhs(sys_);
   Vector lambda = initial_impulses(warm);
-  if (opt_.solver != Method::pgs) active_set_loop(lambda, res);
+  if (!sweeps_only()) active_set_loop(lambda, res);
   // Feasible impulses, then projected Gauss-Seidel sweeps while they are not accurate enough.
   // (Projecting an unsettled pass alone could zero a tensile impulse that balances large
   // compressive ones and kick the bodies between them: 29 m/s in one silo step.)
   project(lambda);
   if (last_reason_ != StopReason::non_finite) finish(lambda, res);
-  if (opt_.solver == Method::pgs && res.complementarity > opt_.sweep_tol) {
+  if (sweeps_only() && res.complementarity > opt_.sweep_tol) {
     res.converged = false;
     res.reason = res.sweep_reason;
   }

@@ -29,8 +29,8 @@ double k_product_seconds(const ContactSystem &sys, int repeat = 21);
 
 struct StudyRow {
   std::string setting;
-  double seconds = 0;       // the fastest of the repeats
-  double k_products = 0;    // seconds / k_product_seconds
+  double seconds = 0;    // the fastest of the repeats
+  double k_products = 0; // seconds / k_product_seconds
   int iterations = 0, passes = 0, sweeps = 0;
   double complementarity = 0;
   bool converged = false;

@@ -19,7 +19,7 @@ struct StepAccuracy {
   double dv_trans = 0, dv_rot = 0;
   double lambda_n = 0, lambda_t = 0, lambda_roll = 0, lambda_twist = 0;
   double velocity() const { return std::max(dv_trans, dv_rot); }
-  double impulse() const;  // the largest of the impulse groups that carry any impulse
+  double impulse() const; // the largest of the impulse groups that carry any impulse
 };
 
 // lambda against the reference ref (both rows per contact of sys).
@@ -38,18 +38,18 @@ NewtonResult semismooth_newton(const ContactSystem &sys, const Cones &cones, con
                                Vector &lambda, double target, int max_iter);
 
 struct ReferenceOptions {
-  double target = 1e-10;      // complementarity residual of both methods
-  int max_sweeps = 2000000;   // projected Gauss-Seidel
+  double target = 1e-10;    // complementarity residual of both methods
+  int max_sweeps = 2000000; // projected Gauss-Seidel
   int max_newton = 60;
 };
 
 struct Reference {
-  Vector lambda;              // the Newton solution when it converged, else the sweeps'
-  int sweeps = 0;             // of projected Gauss-Seidel
+  Vector lambda;  // the Newton solution when it converged, else the sweeps'
+  int sweeps = 0; // of projected Gauss-Seidel
   double complementarity_pgs = 0;
   NewtonResult newton;
-  StepAccuracy agreement;     // the sweeps' solution against Newton's
-  bool confirmed() const;     // both met the target and agree to 1e-6
+  StepAccuracy agreement; // the sweeps' solution against Newton's
+  bool confirmed() const; // both met the target and agree to 1e-6
 };
 
 // Both methods start from `start` (for example the step's default solve).

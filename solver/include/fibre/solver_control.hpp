@@ -15,16 +15,15 @@ namespace fibre {
 //   cr      preconditioned conjugate residual;
 //   minres  Paige-Saunders MINRES;
 //   direct  MUMPS;
-//   pgs     projected Gauss-Seidel on the nonsmooth problem alone (no linear pass).
-enum class Method { cg, cr, minres, direct, pgs };
+//   pgs     projected Gauss-Seidel on the nonsmooth problem alone (no linear pass);
+//   nncg    the same sweeps accelerated by nonsmooth nonlinear CG (pgs.hpp).
+enum class Method { cg, cr, minres, direct, pgs, nncg };
 template <> struct EnumNames<Method> {
-  static constexpr EnumName<Method> table[] = {{Method::cg, "cg"},
-                                               {Method::cr, "cr"},
-                                               {Method::minres, "minres"},
-                                               {Method::direct, "direct"},
-                                               {Method::pgs, "pgs"},
-                                               {Method::cg, "uzawa", true},
-                                               {Method::direct, "mumps", true}};
+  static constexpr EnumName<Method> table[] = {
+      {Method::cg, "cg"},          {Method::cr, "cr"},
+      {Method::minres, "minres"},  {Method::direct, "direct"},
+      {Method::pgs, "pgs"},        {Method::nncg, "nncg"},
+      {Method::cg, "uzawa", true}, {Method::direct, "mumps", true}};
 };
 inline bool is_krylov(Method m)
 {

@@ -40,6 +40,8 @@ struct StepOptions {
   // With solver pgs the sweeps are the whole solve.
   int sweeps = 50;
   double sweep_tol = 1e-3;
+  // The sweeps accelerated by nonsmooth nonlinear CG (always with solver nncg).
+  bool sweep_cg = false;
 };
 
 // The settings as one line, "name value, name value, ..." (PETSc KSPView style): the front
