@@ -138,7 +138,8 @@ void FibreOutput::export_step(const std::string &prefix, const fibre::ContactSys
                  static_cast<long long>(fc.partner > 0 ? fc.partner : 0.0), fc.wall + 1);
     const Eigen::Index at = Eigen::Index(rows) * c;
     for (int r = 0; r < rows; ++r) std::fprintf(fp, " %.17g", lambda ? (*lambda)[at + r] : 0.0);
-    for (int r = 0; r < rows; ++r) std::fprintf(fp, " %.17g", warm.size() > at + r ? warm[at + r] : 0.0);
+    for (int r = 0; r < rows; ++r)
+      std::fprintf(fp, " %.17g", warm.size() > at + r ? warm[at + r] : 0.0);
     std::fprintf(fp, "\n");
   }
   std::fclose(fp);
