@@ -3,20 +3,63 @@
 #include <array>
 #include <cmath>
 
-#include "fibre/kernels.hpp"
+#include "fibre/contact_rows.hpp"
 #include "fibre/spook.hpp"
 
 namespace fibre {
+
+namespace {
+
+// One sweep over the contacts in order: each moves to lambda_c + (b_c - G_c dv - Sigma_c
+// lambda_c) / scale_c and is projected, and dv follows at once. Returns ||change||^2 and
+// ||lambda||^2 (local). The rows of G are applied in their structured form (contact_rows.hpp).
+template <int R>
+void sweep(const ContactSystem &sys, const Cones &cones, const Vector &b,
+           const std::vector<Vec6> &inv_scale, Vector &lambda, Vector &dv, double norms[2])
+{
+  const int nc = sys.num_contacts();
+  const int *pairs = sys.body_pairs();
+  const double *kin = nc > 0 ? sys.kinematics(0).frame.data() : nullptr;
+  const double *inv_mass = sys.inv_mass().data(), *sigma = sys.sigma().data();
+  double *l = lambda.data(), *w = dv.data();
+  for (int c = 0; c < nc; ++c) {
+    const double *q = kin + 15 * std::size_t(c);
+    const int ia = pairs[2 * std::size_t(c)], ib = pairs[2 * std::size_t(c) + 1];
+    double *wa = w + 6 * std::size_t(ia), *wb = ib >= 0 ? w + 6 * std::size_t(ib) : nullptr;
+    double u[6], old[6], delta[6] = {0, 0, 0, 0, 0, 0};
+    contact_velocity<R>(q, q + 9, q + 12, wa, wb, u);
+    double *lc = l + std::size_t(R) * c;
+    const std::size_t at = std::size_t(R) * c;
+    for (int i = 0; i < R; ++i) {
+      old[i] = lc[i];
+      lc[i] += (b[at + i] - u[i] - sigma[at + i] * old[i]) * inv_scale[c][i];
+    }
+    cones.project(lc, c);
+    for (int i = 0; i < R; ++i) {
+      delta[i] = lc[i] - old[i];
+      norms[0] += delta[i] * delta[i];
+      norms[1] += lc[i] * lc[i];
+    }
+    double ya[6] = {0, 0, 0, 0, 0, 0}, yb[6] = {0, 0, 0, 0, 0, 0};
+    contact_impulse<R>(q, q + 9, q + 12, delta, ya, wb ? yb : nullptr);
+    const double *ma = inv_mass + 6 * std::size_t(ia);
+    for (int d = 0; d < 6; ++d) wa[d] += ma[d] * ya[d];
+    if (wb) {
+      const double *mb = inv_mass + 6 * std::size_t(ib);
+      for (int d = 0; d < 6; ++d) wb[d] += mb[d] * yb[d];
+    }
+  }
+}
+
+} // namespace
 
 PgsResult pgs(const ContactSystem &sys, const Exchange &ex, const Cones &cones, const Vector &b,
               const std::vector<Vec6> &scale, Vector &lambda, const PgsControl &control)
 {
   PgsResult res;
   const int nc = sys.num_contacts(), rows = sys.rows();
-  std::vector<std::array<Mat6, 2>> J(nc);
-  for (int c = 0; c < nc; ++c) J[c] = {jacobian_block(sys, c, 0), jacobian_block(sys, c, 1)};
-  const Vector &inv_mass = sys.inv_mass();
-  const Vector &sigma = sys.sigma();
+  std::vector<Vec6> inv_scale(scale.size());
+  for (std::size_t c = 0; c < scale.size(); ++c) inv_scale[c] = scale[c].cwiseInverse();
   Vector dv = velocity_change(sys, ex, lambda);
   Vector dv_start, moved, lambda_start; // reused by every sweep
   double best = INFINITY;
@@ -28,25 +71,10 @@ PgsResult pgs(const ContactSystem &sys, const Exchange &ex, const Cones &cones, 
     dv_start = dv;
     lambda_start = lambda;
     double norms[2] = {0, 0}; // ||change||^2, ||lambda||^2
-    for (int c = 0; c < nc; ++c) {
-      const Contact &k = sys.contacts()[c];
-      const Eigen::Index at = Eigen::Index(rows) * c, ia = 6 * Eigen::Index(k.a),
-                         ib = 6 * Eigen::Index(k.b);
-      Vec6 G_dv = J[c][0] * dv.segment<6>(ia);
-      if (!k.is_wall()) G_dv += J[c][1] * dv.segment<6>(ib);
-      Vec6 old = Vec6::Zero();
-      old.head(rows) = lambda.segment(at, rows);
-      for (int i = 0; i < rows; ++i)
-        lambda[at + i] += (b[at + i] - G_dv[i] - sigma[at + i] * old[i]) / scale[c][i];
-      cones.project(lambda.data() + at, c);
-      Vec6 change = Vec6::Zero();
-      change.head(rows) = lambda.segment(at, rows) - old.head(rows);
-      dv.segment<6>(ia) += inv_mass.segment<6>(ia).cwiseProduct(J[c][0].transpose() * change);
-      if (!k.is_wall())
-        dv.segment<6>(ib) += inv_mass.segment<6>(ib).cwiseProduct(J[c][1].transpose() * change);
-      norms[0] += change.squaredNorm();
-      norms[1] += lambda.segment(at, rows).squaredNorm();
-    }
+    if (rows == 6)
+      sweep<6>(sys, cones, b, inv_scale, lambda, dv, norms);
+    else
+      sweep<3>(sys, cones, b, inv_scale, lambda, dv, norms);
     // Every process's updates on every body: the sum of the local changes, owners and ghosts.
     moved = dv - dv_start;
     ex.reverse_sum(moved);

@@ -1,6 +1,7 @@
 #include "fibre/text.hpp"
 
 #include <cerrno>
+#include <cfloat>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -13,7 +14,9 @@ bool to_double(const char *text, double &value)
   char *end = nullptr;
   errno = 0;
   value = std::strtod(text, &end);
-  return end != text && *end == '\0' && errno == 0 && std::isfinite(value);
+  // ERANGE also flags an underflow to a subnormal or zero, which is a value like any other
+  const bool range_ok = errno == 0 || (errno == ERANGE && std::fabs(value) < DBL_MIN);
+  return end != text && *end == '\0' && range_ok && std::isfinite(value);
 }
 
 bool to_long(const char *text, long &value)

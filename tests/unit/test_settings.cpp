@@ -6,6 +6,7 @@
 #include <sstream>
 
 #include "fibre/settings.hpp"
+#include "fibre/text.hpp"
 
 using namespace fibre;
 
@@ -97,6 +98,25 @@ TEST(Settings, EveryKeywordSetsWhatItNames)
   EXPECT_NE(describe(s).find("compliance 1e-07 2e-07"), std::string::npos);
   EXPECT_EQ(parse_settings(words("solver pgs")).step.solver, Method::pgs);
   EXPECT_EQ(parse_settings(words("solver mumps")).step.solver, Method::direct);
+}
+
+// Strict numbers: the whole word, finite; an underflow to a subnormal is a number, an overflow
+// is not.
+TEST(Settings, StrictNumbers)
+{
+  double x = 0;
+  EXPECT_TRUE(to_double("-9.8813129168249309e-324", x));
+  EXPECT_EQ(x, -9.8813129168249309e-324);
+  EXPECT_TRUE(to_double("1e-400", x)); // underflows to 0
+  EXPECT_FALSE(to_double("1e400", x));
+  EXPECT_FALSE(to_double("inf", x));
+  EXPECT_FALSE(to_double("1.5x", x));
+  EXPECT_FALSE(to_double("", x));
+  long n = 0;
+  EXPECT_TRUE(to_long("-12", n));
+  EXPECT_EQ(n, -12);
+  EXPECT_FALSE(to_long("12.0", n));
+  EXPECT_FALSE(to_long("99999999999999999999999", n));
 }
 
 TEST(Settings, BadInputNamesTheKeywordAndItsForm)
