@@ -1,0 +1,51 @@
+#!/bin/bash
+# Accuracy against cost of the nonsmooth step: every state (a .sys/.lambda pair that
+# bench/export_states.sh or `fix fibre_contact export` wrote) is replayed by fibre_accuracy
+# with four families of settings, each against the state's converged reference (projected
+# Gauss-Seidel and semismooth Newton to a complementarity residual of 1e-10, cross-checked):
+#   pgs        solver pgs, S sweeps
+#   nncg       solver nncg (the sweeps with nonsmooth nonlinear CG), S sweeps
+#   default    the default linear pass (body form, tree-preconditioned CG) then S sweeps
+#   default+cg the same with the sweeps accelerated (sweep_cg yes)
+# for S in the list below. One CSV per state in the work directory, then
+# bench/plot_accuracy.py draws the curves (velocity error against K-product equivalents) and
+# prints the table of bench/README.md.
+#
+# Usage: bench/accuracy_study.sh [--states DIR] [--tool build/tools/fibre_accuracy]
+#                                [--work /tmp/fibre_accuracy] [--png bench/accuracy_curves.png]
+set -euo pipefail
+src=$(cd "$(dirname "$0")/.." && pwd)
+states=/tmp/fibre_states
+tool=$src/build/tools/fibre_accuracy
+work=/tmp/fibre_accuracy
+png=$src/bench/accuracy_curves.png
+while [ $# -gt 0 ]; do
+  case $1 in
+    -h|--help) awk 'NR == 1 { next } !/^#/ { exit } { sub(/^# ?/, ""); print }' "$0"; exit 0 ;;
+    --states|--tool|--work|--png)
+      [ $# -ge 2 ] || { echo "accuracy_study.sh: $1 needs a value" >&2; exit 2; }
+      case $1 in
+        --states) states=$2 ;; --tool) tool=$2 ;; --work) work=$2 ;; --png) png=$2 ;;
+      esac
+      shift 2 ;;
+    *) echo "accuracy_study.sh: unknown option $1 (--help: the usage)" >&2; exit 2 ;;
+  esac
+done
+mkdir -p "$work"
+settings=()
+for s in 5 10 20 50 100 200 500 1000; do
+  settings+=(--setting "solver pgs sweeps $s sweep_tol 1e-14")
+  settings+=(--setting "solver nncg sweeps $s sweep_tol 1e-14")
+done
+for s in 0 5 10 20 50 100 200 500; do
+  settings+=(--setting "sweeps $s sweep_tol 1e-14")
+  settings+=(--setting "sweep_cg yes sweeps $s sweep_tol 1e-14")
+done
+settings+=(--setting "")
+for sys in "$states"/*.sys; do
+  name=$(basename "$sys" .sys)
+  echo "== $name"
+  "$tool" "${sys%.sys}" --repeat 3 --csv "$work/$name.csv" "${settings[@]}" \
+    | tee "$work/$name.txt" | head -4
+done
+python3 "$src/bench/plot_accuracy.py" --png "$png" "$work"/*.csv

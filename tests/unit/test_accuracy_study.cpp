@@ -1,0 +1,81 @@
+// The accuracy study on a shipped exported step (examples/material, N 350, step 600: 348
+// contacts, exported with its warm start by fix fibre_contact): the export is the whole step
+// (replaying the default solve from its warm start gives the run's impulses again), the two
+// reference methods agree, and the measure orders the solvers as they are: more sweeps are
+// more accurate, nonlinear CG beats plain sweeps at equal count.
+#include <gtest/gtest.h>
+
+#include "fibre/accuracy_study.hpp"
+#include "fibre/system_io.hpp"
+#include "reference.hpp"
+
+#include <cstdio>
+#include <fstream>
+#include <unistd.h>
+
+using namespace fibre;
+
+namespace {
+
+const std::string kState = std::string(FIBRE_TEST_DATA_DIR) + "/material350_step600";
+
+StepOptions sweeps_only(Method m, int sweeps)
+{
+  StepOptions o;
+  o.solver = m;
+  o.sweeps = sweeps;
+  o.sweep_tol = 1e-14;
+  return o;
+}
+
+} // namespace
+
+TEST(AccuracyStudy, ExportedStepReplaysAndHasAConfirmedReference)
+{
+  const StepState st = read_step_state(kState);
+  ASSERT_EQ(st.sys.num_contacts(), 348);
+  EXPECT_GT(st.warm.norm(), 0.0);
+  const Reference ref = nonsmooth_reference(st.sys, st.lambda);
+  EXPECT_LE(ref.complementarity_pgs, 1e-10);
+  EXPECT_TRUE(ref.newton.converged);
+  EXPECT_TRUE(ref.confirmed()) << ref.agreement.velocity() << " " << ref.agreement.impulse();
+
+  // the default solve from the exported warm start is the run's own solve
+  const double tk = k_product_seconds(st.sys, 5);
+  const StudyRow def = measure_setting(st, StepOptions{}, ref.lambda, tk, 1);
+  const StepAccuracy run = step_accuracy(st.sys, st.lambda, ref.lambda);
+  EXPECT_NEAR(def.error.velocity(), run.velocity(), 1e-12 * run.velocity());
+  // measured 5.1e-3 / 2.6e-2 (translational / rotational): the default misses issue #13's
+  // 1e-3, which these figures track
+  EXPECT_GT(def.error.velocity(), 1e-3);
+  EXPECT_LT(def.error.velocity(), 0.1);
+
+  const StudyRow pgs50 = measure_setting(st, sweeps_only(Method::pgs, 50), ref.lambda, tk, 1);
+  const StudyRow nncg50 = measure_setting(st, sweeps_only(Method::nncg, 50), ref.lambda, tk, 1);
+  const StudyRow pgs2000 = measure_setting(st, sweeps_only(Method::pgs, 2000), ref.lambda, tk, 1);
+  EXPECT_EQ(pgs50.sweeps, 50);
+  EXPECT_LT(nncg50.error.velocity(), pgs50.error.velocity());
+  EXPECT_LT(pgs2000.error.velocity(), 1e-6);
+  EXPECT_LT(pgs2000.error.impulse(), 1e-6);
+}
+
+TEST(AccuracyStudy, BadStateFilesAreNamed)
+{
+  EXPECT_THROW(read_step_state("/nonexistent/state"), std::runtime_error);
+  const std::string path = "/tmp/fibre_bad_state_" + std::to_string(::getpid());
+  {
+    const StepState st = read_step_state(kState);
+    std::ofstream sys(path + ".sys");
+    write_system(sys, st.sys);
+    std::ofstream lam(path + ".lambda");
+    lam << "# header\n0 1 2 0 1 2 3\n"; // too few values
+  }
+  try {
+    read_step_state(path);
+    ADD_FAILURE() << "accepted a bad .lambda";
+  } catch (const std::runtime_error &e) {
+    EXPECT_NE(std::string(e.what()).find(".lambda, line 2"), std::string::npos) << e.what();
+  }
+  std::remove((path + ".sys").c_str());
+  std::remove((path + ".lambda").c_str());
+}
