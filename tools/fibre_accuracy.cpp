@@ -118,7 +118,7 @@ int run(const Options &opt)
               sys.num_bodies(), sys.num_contacts(), sys.rows());
   const auto t0 = Clock::now();
   const Reference ref =
-      nonsmooth_reference(sys, state.lambda, ReferenceOptions{opt.target, 2000000, 60});
+      nonsmooth_reference(sys, state.lambda, ReferenceOptions{opt.target, 2000000, 30});
   std::printf("reference (%.1f s): projected Gauss-Seidel %d sweeps, residual %.2e; semismooth "
               "Newton %d iterations, residual %.2e%s\n",
               seconds_since(t0), ref.sweeps, ref.complementarity_pgs, ref.newton.iterations,

@@ -176,16 +176,19 @@ Reference nonsmooth_reference(const ContactSystem &sys, const Vector &start,
   const std::vector<Vec6> scale = row_scales(sys);
   Vector pgs_lambda = start;
   for (int c = 0; c < sys.num_contacts(); ++c) cones.project(pgs_lambda.data() + sys.rows() * c, c);
-  // sweeps in rounds, until the residual (not only the change per sweep) meets the target
+  // Sweeps in rounds, until the residual (not only the change per sweep) meets the target.
+  // Newton starts where the sweeps passed 1e-6: close enough for its local convergence, far
+  // enough that agreeing with the sweeps' end point is a check of that point.
+  Vector newton_lambda;
   while (ref.sweeps < opt.max_sweeps) {
-    const PgsResult r =
-        pgs(sys, serial_exchange(), cones, b, scale, pgs_lambda,
-            PgsControl{std::min(2000, opt.max_sweeps - ref.sweeps), 1e-15, 1 << 30});
+    const PgsResult r = pgs(sys, serial_exchange(), cones, b, scale, pgs_lambda,
+                            PgsControl{std::min(500, opt.max_sweeps - ref.sweeps), 1e-15, 1 << 30});
     ref.sweeps += r.sweeps;
     ref.complementarity_pgs = complementarity(sys, serial_exchange(), cones, b, pgs_lambda, scale);
+    if (newton_lambda.size() == 0 && ref.complementarity_pgs <= 1e-6) newton_lambda = pgs_lambda;
     if (ref.complementarity_pgs <= opt.target || r.reason == StopReason::non_finite) break;
   }
-  Vector newton_lambda = start;
+  if (newton_lambda.size() == 0) newton_lambda = pgs_lambda;
   ref.newton = semismooth_newton(sys, cones, b, newton_lambda, opt.target, opt.max_newton);
   // Newton's iterate is feasible only in the limit: its projection is the answer
   for (int c = 0; c < sys.num_contacts(); ++c)
