@@ -50,4 +50,7 @@ for sys in "$states"/*.sys; do
     > "$work/$name.txt" || echo "fibre_accuracy exit status $?: see $work/$name.txt"
   head -4 "$work/$name.txt"
 done
-python3 "$src/bench/plot_accuracy.py" --png "$png" "$work"/*.csv
+# Debian's python3 has matplotlib (a python3 earlier on PATH may not)
+py=/usr/bin/python3
+[ -x "$py" ] || py=python3
+"$py" "$src/bench/plot_accuracy.py" --png "$png" "$work"/*.csv

@@ -13,6 +13,7 @@ import math
 import os
 
 FAMILIES = ["pgs", "nncg", "default", "default+cg"]
+DEFAULT = "(defaults)"  # fibre_accuracy's name of the empty setting
 
 
 def family(setting):
@@ -49,9 +50,9 @@ def main():
           "its velocity / impulse error | defaults: K-products, velocity, impulse |")
     print("|---|---|---|---|---|")
     for name, rows in states:
-        default = [r for r in rows if r["setting"] == ""]
+        default = [r for r in rows if r["setting"] == DEFAULT]
         for fam in FAMILIES:
-            ok = [r for r in rows if r["family"] == fam and r["setting"] != ""
+            ok = [r for r in rows if r["family"] == fam and r["setting"] != DEFAULT
                   and r["velocity"] <= 1e-3 and r["impulse"] <= 1e-2]
             best = min(ok, key=lambda r: r["k_products"]) if ok else None
             d = default[0] if default and fam == "default" else None
@@ -74,11 +75,11 @@ def main():
     for ax, (name, rows) in zip(axes.flat, states):
         for fam in FAMILIES:
             pts = sorted((r["k_products"], r["velocity"]) for r in rows
-                         if r["family"] == fam and r["setting"] != "" and r["velocity"] > 0)
+                         if r["family"] == fam and r["setting"] != DEFAULT and r["velocity"] > 0)
             if pts:
                 ax.loglog([x for x, _ in pts], [y for _, y in pts], styles[fam], ms=3, label=fam)
         for r in rows:
-            if r["setting"] == "":
+            if r["setting"] == DEFAULT:
                 ax.loglog([r["k_products"]], [r["velocity"]], "k*", ms=10, label="defaults")
         ax.axhline(1e-3, color="grey", lw=0.8, ls="--")
         ax.axvline(40, color="grey", lw=0.8, ls=":")
