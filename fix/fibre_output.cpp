@@ -44,6 +44,7 @@ void FibreOutput::report_solve(const fibre::StepResult &res)
   stats_[V_CONVERGED] = res.converged ? 1.0 : 0.0;
   stats_[V_COMPLEMENTARITY] = res.complementarity;
   stats_[V_SWEEPS] = res.sweeps;
+  stats_[V_ERROR_ESTIMATE] = res.error_estimate;
 
   double sums[3] = {double(res.fibres.num_fibres), double(res.fibres.contacts_in_fibres),
                     double(res.fibres.num_contacts)};
@@ -162,12 +163,13 @@ void FibreOutput::write_restart(FILE *fp) const
 void FibreOutput::read_restart(const char *buf)
 {
   const double *list = reinterpret_cast<const double *>(buf);
-  if (list[0] != kRestartFormat) {
+  const int values = list[0] == kRestartFormat ? V_SIZE : list[0] == 2.0 ? V_ERROR_ESTIMATE : 0;
+  if (values == 0) {
     error->warning(FLERR, std::string("Fix fibre_contact: restart data of another format ignored"));
     return;
   }
   nonconverged_total_ = static_cast<bigint>(list[1]);
-  for (int k = 0; k < V_SIZE; ++k) stats_[k] = list[2 + k];
+  for (int k = 0; k < values; ++k) stats_[k] = list[2 + k];
 }
 
 double FibreOutput::memory_bytes() const

@@ -29,13 +29,14 @@ enum Stat {
   V_COMPLEMENTARITY,
   V_SWEEPS,
   V_SWEEP_TIME,
+  V_ERROR_ESTIMATE,
   V_SIZE
 };
 
 class FibreOutput : protected LAMMPS_NS::Pointers {
  public:
   static constexpr int kLocalColumns = 8;
-  static constexpr double kRestartFormat = 2.0; // 2: 15 global values
+  static constexpr double kRestartFormat = 3.0; // 3: 16 global values (2: 15, still read)
 
   explicit FibreOutput(LAMMPS_NS::LAMMPS *lmp) : Pointers(lmp) {}
   ~FibreOutput() override;

@@ -84,6 +84,7 @@ StudyRow measure_setting(const StepState &state, const StepOptions &opt, const V
   row.passes = res.active_set_passes;
   row.sweeps = res.sweeps;
   row.complementarity = res.complementarity;
+  row.error_estimate = res.error_estimate;
   row.converged = res.converged;
   row.error = step_accuracy(state.sys, res.lambda, reference);
   return row;

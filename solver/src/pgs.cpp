@@ -8,6 +8,13 @@
 
 namespace fibre {
 
+double PgsResult::error_estimate() const
+{
+  if (last_change == 0) return 0;
+  if (!(contraction < 1)) return INFINITY;
+  return last_change * contraction / (1 - contraction);
+}
+
 namespace {
 
 // One sweep over the contacts in order: each moves to lambda_c + (b_c - G_c dv - Sigma_c
@@ -66,6 +73,7 @@ PgsResult pgs(const ContactSystem &sys, const Exchange &ex, const Cones &cones, 
   int since_best = 0;
   Vector direction, change; // nonlinear CG
   double last_change2 = 0;
+  std::vector<double> changes; // relative change per sweep
   for (int s = 0; s < control.max_sweeps; ++s) {
     // dv follows this process's updates; `moved` collects them for the other processes.
     dv_start = dv;
@@ -88,6 +96,11 @@ PgsResult pgs(const ContactSystem &sys, const Exchange &ex, const Cones &cones, 
       return res;
     }
     res.last_change = norms[1] > 0 ? std::sqrt(norms[0] / norms[1]) : 0.0;
+    changes.push_back(res.last_change);
+    if (changes.size() > std::size_t(kRateWindow)) {
+      const double first = changes[changes.size() - 1 - kRateWindow];
+      res.contraction = first > 0 ? std::pow(res.last_change / first, 1.0 / kRateWindow) : 1.0;
+    }
     res.reason = StopReason::max_iterations;
     if (!(norms[0] > control.tol * control.tol * norms[1])) {
       res.reason = StopReason::converged;

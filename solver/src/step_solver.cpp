@@ -267,12 +267,14 @@ void StepSolver::finish(Vector &lambda, StepResult &res) const
   const auto t_sweep = Clock::now();
   const std::vector<Vec6> scale = row_scales(sys_);
   res.complementarity = complementarity(sys_, ex_, cones_, b_full_, lambda, scale);
+  res.error_estimate = res.complementarity;
   if (opt_.sweeps > 0 && res.complementarity > opt_.sweep_tol) {
     PgsControl control{opt_.sweeps, opt_.sweep_tol};
     control.nonlinear_cg = opt_.sweep_cg || opt_.solver == Method::nncg;
     const PgsResult pr = pgs(sys_, ex_, cones_, b_full_, scale, lambda, control);
     res.sweeps = pr.sweeps;
     res.sweep_reason = pr.reason;
+    res.error_estimate = pr.error_estimate();
     res.complementarity = complementarity(sys_, ex_, cones_, b_full_, lambda, scale);
   }
   res.sweep_seconds = seconds_since(t_sweep);

@@ -26,7 +26,7 @@ timestep 0.001
 fix g all gravity 9.81 vector 0 0 -1
 fix fc all fibre_contact mu 0.5 sweep_tol 1e-14 wall zplane 0.0 NULL
 thermo_style custom step f_fc[1] f_fc[2] f_fc[3] f_fc[6] f_fc[8] f_fc[9] f_fc[10] f_fc[13] &
-  f_fc[14] f_fc[15]
+  f_fc[14] f_fc[15] f_fc[16]
 thermo_modify format float %.10g
 thermo 1
 run 20
@@ -35,7 +35,7 @@ run 20
 """
 
 SOLVER_FIGURES = ["f_fc[1]", "f_fc[2]", "f_fc[6]", "f_fc[8]", "f_fc[9]", "f_fc[13]", "f_fc[14]",
-                  "f_fc[15]"]
+                  "f_fc[15]", "f_fc[16]"]
 
 
 def main():

@@ -59,6 +59,23 @@ TEST(AccuracyStudy, ExportedStepReplaysAndHasAConfirmedReference)
   EXPECT_LT(pgs2000.error.impulse(), 1e-6);
 }
 
+// The sweeps' error estimate (f_ID[16]) against the true error of the normal impulses, for the
+// default and for projected Gauss-Seidel cut at several counts: within a factor of 3.
+TEST(AccuracyStudy, ErrorEstimateTracksTheTrueError)
+{
+  const StepState st = read_step_state(kState);
+  const Reference ref = nonsmooth_reference(st.sys, st.lambda);
+  std::vector<StepOptions> settings = {StepOptions{}};
+  for (int sweeps : {20, 50, 200, 500}) settings.push_back(sweeps_only(Method::pgs, sweeps));
+  for (const StepOptions &o : settings) {
+    const StudyRow row = measure_setting(st, o, ref.lambda, 1.0, 1);
+    SCOPED_TRACE(describe(o));
+    ASSERT_GT(row.sweeps, 5);
+    EXPECT_LT(row.error_estimate, 3.0 * row.error.lambda_n);
+    EXPECT_GT(row.error_estimate, row.error.lambda_n / 3.0);
+  }
+}
+
 TEST(AccuracyStudy, BadStateFilesAreNamed)
 {
   EXPECT_THROW(read_step_state("/nonexistent/state"), std::runtime_error);

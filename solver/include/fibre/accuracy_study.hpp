@@ -33,6 +33,7 @@ struct StudyRow {
   double k_products = 0; // seconds / k_product_seconds
   int iterations = 0, passes = 0, sweeps = 0;
   double complementarity = 0;
+  double error_estimate = 0; // StepResult::error_estimate
   bool converged = false;
   StepAccuracy error;
 };

@@ -25,10 +25,18 @@ struct PgsControl {
   bool nonlinear_cg = false;
 };
 
+inline constexpr int kRateWindow = 5;
+
 struct PgsResult {
   StopReason reason = StopReason::max_iterations;
   int sweeps = 0;
   double last_change = 0; // of the last sweep, relative to |lambda|
+  // The sweeps contract the error by about `contraction` per sweep (the geometric mean of the
+  // last kRateWindow ratios of successive changes), so the impulses' remaining relative error
+  // is about last_change * contraction / (1 - contraction): infinite while the changes do not
+  // fall.
+  double contraction = 1;
+  double error_estimate() const;
   bool converged() const { return reason == StopReason::converged; }
 };
 

@@ -66,8 +66,11 @@ struct StepResult {
   double complementarity = 0;
   int sweeps = 0; // projected Gauss-Seidel sweeps done after the loop
   StopReason sweep_reason = StopReason::converged; // of the sweeps (converged when none ran)
-  FibreStats fibres;                               // of the last pass's preconditioner
-  double setup_seconds = 0;                        // preconditioner builds
+  // The impulses' remaining relative error as the sweeps estimate it (PgsResult): infinite
+  // when they did not contract, the complementarity residual when none ran.
+  double error_estimate = 0;
+  FibreStats fibres;        // of the last pass's preconditioner
+  double setup_seconds = 0; // preconditioner builds
   double solve_seconds = 0; // linear solves (direct: analysis, factorization and solve)
   double sweep_seconds = 0; // projected Gauss-Seidel sweeps and the residuals around them
   double total_seconds = 0; // the whole call
