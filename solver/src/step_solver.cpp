@@ -382,7 +382,9 @@ StepResult StepSolver::run(const Vector *warm)
   if (last_reason_ != StopReason::non_finite) finish(lambda, res);
   if (sweeps_only() && res.complementarity > opt_.sweep_tol) {
     res.converged = false;
-    res.reason = res.sweep_reason;
+    // sweeps that stopped moving above the tolerance stagnated
+    res.reason =
+        res.sweep_reason == StopReason::converged ? StopReason::stagnation : res.sweep_reason;
   }
   count_set(lambda, res);
   sys_.set_rhs(b_full_);

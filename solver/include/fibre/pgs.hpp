@@ -18,7 +18,7 @@ namespace fibre {
 struct PgsControl {
   int max_sweeps = 50;
   double tol = 1e-3;
-  int stall_sweeps = 100;
+  int stall_sweeps = 1000;
   // Nonsmooth nonlinear CG (Silcowitz, Niebe and Erleben 2010): the sweep's change is a
   // descent direction, and beta = |r_k+1|^2 / |r_k|^2 of the previous direction is added to it
   // (restarted when beta > 1); one extra G^T product per sweep.

@@ -1,0 +1,91 @@
+"""Every step solver gives the same physics on one and on two processes, to its tolerance.
+
+A 4 x 4 x 3 lattice of spheres (radius 0.5, spacing 1.1) with random velocities (the same on
+any process count: `velocity ... loop geom`) falls, collides and settles on a floor under gravity with
+mu 0.5 and mu_roll 0.05, in a box split across x between the processes (`processors * 1 1`),
+for 60 steps, with the default solver, `solver pgs`, `solver nncg` and `sweep_cg yes`, each
+solved tightly (linear pass to 1e-10, sweeps to 1e-10): the collisions amplify any difference,
+so the runs are compared after 10 steps (the first collisions), where a difference is still the
+solver's own. On two processes each process sweeps its own contacts (block Jacobi across
+processes), so the runs agree to the sweeps' tolerance, not to round-off: positions within
+1e-9 m and velocities within 1e-6 m/s of the serial run (the largest velocity is about 1 m/s). The
+difference after all 60 steps, grown by the collisions, is reported. Plain sweeps (the
+default's finish and solver pgs) do not converge on some collision steps of this scene
+(they stop at their cap): there the runs must say so (f_fc[12] > 0), and nonlinear CG, which
+converges on every step, must agree.
+"""
+
+import fibre_e2e as e2e
+
+DECK = """atom_style sphere
+boundary p p f
+newton off
+processors * 1 1
+comm_modify vel yes
+region box block -0.55 3.85 -0.55 3.85 0 8 units box
+create_box 1 box
+lattice sc 1.1
+region pile block 0 4.3 0 4.3 0 3.2 units box
+create_atoms 1 region pile units box
+displace_atoms all move 0.0 0.0 0.5 units box
+reset_atom_ids sort yes
+set type 1 diameter 1.0 density 1.0
+pair_style gran/hooke 1.0 NULL 0.0 NULL 0.0 0
+pair_coeff * *
+velocity all create 0.3 4928 loop geom
+neighbor 0.2 bin
+timestep 0.005
+fix g all gravity 9.81 vector 0 0 -1
+fix fc all fibre_contact mu 0.5 mu_roll 0.05 wall zplane 0.0 NULL {opts}
+thermo_style custom step ke f_fc[3] f_fc[10] f_fc[12] f_fc[13] f_fc[14]
+thermo 10
+dump d all custom 10 {name}.dump id x y z vx vy vz
+dump_modify d sort id format float %.17g
+run 60
+"""
+
+SOLVERS = {
+    "default": "tol 1e-10 sweeps 5000 sweep_tol 1e-10",
+    "pgs": "solver pgs sweeps 5000 sweep_tol 1e-10",
+    "nncg": "solver nncg sweeps 5000 sweep_tol 1e-10",
+    "sweep_cg": "sweep_cg yes sweeps 5000 sweep_tol 1e-10",
+}
+
+
+def main():
+    args = e2e.parse_args()
+    ck = e2e.Checks("solvers: serial and two processes agree to the solver tolerance")
+    for label, opts in SOLVERS.items():
+        dumps, failed = {}, {}
+        for np in (1, 2):
+            name = "solvers_%s_np%d" % (label, np)
+            run = e2e.run_lmp(args, DECK.format(opts=opts, name=name), name, np=np)
+            if not ck.ran(run):
+                continue
+            failed[np] = run.last("f_fc[12]")
+            dumps[np] = [e2e.dump_by_id(f) for f in e2e.parse_dump(args.workdir + "/" + name + ".dump")]
+        if len(dumps) < 2:
+            continue
+
+        def difference(frame):
+            a, b = dumps[1][frame], dumps[2][frame]
+            dx = max(abs(a[i][k] - b[i][k]) for i in a for k in ("x", "y", "z"))
+            dv = max(abs(a[i][k] - b[i][k]) for i in a for k in ("vx", "vy", "vz"))
+            return dx, dv
+
+        dx, dv = difference(1)  # step 10
+        agree = dx < 1e-9 and dv < 1e-6
+        ck.check(agree or (failed[1] > 0 and failed[2] > 0),
+                 "%s: np 2 agrees with serial after 10 steps, or both runs report the steps "
+                 "whose solve did not converge" % label,
+                 "largest position difference %.2g m, velocity %.2g m/s; after 60 steps %.2g m, "
+                 "%.2g m/s; non-converged steps %g and %g" % ((dx, dv) + difference(-1) +
+                                                               (failed[1], failed[2])))
+        if label in ("nncg", "sweep_cg"):  # these converge on every step of this scene
+            ck.check(agree and failed[1] == 0 and failed[2] == 0,
+                     "%s: every step converged and np 2 agrees" % label)
+    ck.close()
+
+
+if __name__ == "__main__":
+    main()
