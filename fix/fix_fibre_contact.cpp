@@ -22,6 +22,7 @@
 #include "domain.h"
 #include "error.h"
 #include "fibre_detect.h"
+#include "fibre/text.hpp"
 #include "fibre_output.h"
 #include "force.h"
 #include "group.h"
@@ -159,6 +160,7 @@ void FixFibreContact::init()
 
 void FixFibreContact::setup(int /*vflag*/)
 {
+  first_step_ = true;
   if (!force->pair || !force->pair->list)
     error->all(FLERR, std::string("Fix fibre_contact found no neighbor list of the pair style"));
   dtv_ = update->dt;
@@ -197,14 +199,40 @@ void FixFibreContact::check_finite(const char *what, double **array, int nvalues
   }
 }
 
-// The lightest body of the group over all processes (automatic compliance); the last value
-// stands while the group is empty.
-double FixFibreContact::lightest_mass(const std::vector<fibre::Body> &bodies) const
+// The lightest body and the smallest radius of the group over all processes (automatic
+// compliance and recovery speed); the last values stand while the group is empty.
+void FixFibreContact::smallest_body(const std::vector<fibre::Body> &bodies)
 {
-  double m = std::numeric_limits<double>::infinity();
-  for (int k = 0; k < exchange_->num_owned(); ++k) m = std::min(m, bodies[k].mass);
-  MPI_Allreduce(MPI_IN_PLACE, &m, 1, MPI_DOUBLE, MPI_MIN, world);
-  return std::isfinite(m) ? m : m_min_;
+  double m[2] = {std::numeric_limits<double>::infinity(), std::numeric_limits<double>::infinity()};
+  for (int k = 0; k < exchange_->num_owned(); ++k) {
+    m[0] = std::min(m[0], bodies[k].mass);
+    m[1] = std::min(m[1], bodies[k].radius);
+  }
+  MPI_Allreduce(MPI_IN_PLACE, m, 2, MPI_DOUBLE, MPI_MIN, world);
+  if (std::isfinite(m[0])) m_min_ = m[0];
+  if (std::isfinite(m[1])) r_min_ = m[1];
+}
+
+// At the first step of a run: overlaps deeper than kDeepOverlap of the smaller diameter are
+// removed at the recovery speed, over many steps; say so.
+void FixFibreContact::warn_deep_overlaps(const std::vector<fibre::Body> &bodies,
+                                         const std::vector<fibre::DetectedContact> &found,
+                                         double max_recovery)
+{
+  double deepest = 0.0;
+  for (const fibre::DetectedContact &fc : found) {
+    const fibre::Contact &c = fc.contact;
+    const double rmin =
+        c.is_wall() ? bodies[c.a].radius : std::min(bodies[c.a].radius, bodies[c.b].radius);
+    deepest = std::max(deepest, -c.gap / (2.0 * rmin));
+  }
+  MPI_Allreduce(MPI_IN_PLACE, &deepest, 1, MPI_DOUBLE, MPI_MAX, world);
+  if (deepest > kDeepOverlap && comm->me == 0)
+    error->warning(FLERR, "Fix fibre_contact: the run starts with overlaps of up to " +
+                              fibre::format_g(100.0 * deepest) +
+                              "% of a diameter; they are removed at recovery_speed " +
+                              (max_recovery > 0 ? fibre::format_g(max_recovery) : "none") +
+                              " (SPOOK removes any overlap within a few steps otherwise)");
 }
 
 /* ----------------------------------------------------------------------
@@ -277,10 +305,12 @@ void FixFibreContact::final_integrate()
   check_finite("angular velocity", atom->omega, 3);
 
   const fibre::ContactModel &model = settings_.model;
-  const fibre::SpookParams params{dtv_, model.damping};
   std::vector<fibre::Body> bodies = detection_->bodies();
   std::vector<fibre::DetectedContact> found = detection_->contacts(bodies, dtv_, model.damping);
-  m_min_ = lightest_mass(bodies);
+  smallest_body(bodies);
+  const fibre::SpookParams params{dtv_, model.damping, model.max_recovery(dtv_, r_min_)};
+  if (first_step_) warn_deep_overlaps(bodies, found, params.max_recovery);
+  first_step_ = false;
   const bool any = output_->count_contacts(found) > 0;
   const bool do_export =
       settings_.export_every > 0 && update->ntimestep % settings_.export_every == 0;

@@ -57,13 +57,17 @@ class FixFibreContact : public Fix {
   void check_pair_style(bool at_init);
   void warn_double_integration();
   void check_finite(const char *what, double **array, int nvalues) const;
-  double lightest_mass(const std::vector<fibre::Body> &bodies) const;
+  void smallest_body(const std::vector<fibre::Body> &bodies);
+  void warn_deep_overlaps(const std::vector<fibre::Body> &bodies,
+                          const std::vector<fibre::DetectedContact> &found, double max_recovery);
   fibre::StepResult solve(fibre::ContactSystem &sys, const fibre::Vector &warm);
   void update_velocities(const fibre::Vector *dv);
 
   fibre::Settings settings_;
   double dtv_ = 0.0;
-  double m_min_ = 0.0;
+  static constexpr double kDeepOverlap = 0.05; // of the smaller diameter: warned at a run's start
+  double m_min_ = 0.0, r_min_ = 0.0;
+  bool first_step_ = true;
   class Pair *pair_ = nullptr; // pair style whose force computation this fix switched off
   std::unique_ptr<fibre_lmp::LammpsExchange> exchange_;
   std::unique_ptr<fibre_lmp::LammpsDetection> detection_;

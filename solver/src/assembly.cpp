@@ -76,7 +76,7 @@ Vector assemble_rhs(const ContactSystem &sys)
   Vector rhs = -(1.0 - ups) * (G * v) - p.h * (G * sys.inv_mass().cwiseProduct(f));
   for (int c = 0; c < sys.num_contacts(); ++c) {
     const Eigen::Index row = Eigen::Index(sys.rows()) * c;
-    if (sys.row_active(row)) rhs[row] -= 4.0 / p.h * ups * sys.contacts()[c].gap;
+    if (sys.row_active(row)) rhs[row] += p.gap_term(sys.contacts()[c].gap);
   }
   return rhs;
 }

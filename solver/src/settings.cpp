@@ -153,6 +153,18 @@ std::size_t read_model_keyword(const Reader &in, std::size_t i, Settings &s)
     (key == "mu" ? f.mu : key == "mu_roll" ? f.mu_roll : f.mu_twist) = v;
     return 2;
   }
+  if (key == "recovery_speed") {
+    const std::string e = "'recovery_speed auto|none|<positive speed>'";
+    if (!in.has(i + 1)) Reader::illegal(e);
+    const std::string &v = in.at(i + 1);
+    if (v == "auto")
+      s.model.recovery_speed = -1.0;
+    else if (v == "none")
+      s.model.recovery_speed = 0.0;
+    else
+      s.model.recovery_speed = in.positive(i + 1, e);
+    return 2;
+  }
   if (key == "rows") {
     const std::string e = "'rows 3|6'";
     long v = 0;
@@ -190,7 +202,7 @@ Settings parse_settings(const std::vector<std::string> &args)
     if (!used)
       Reader::illegal("a keyword (form, solver, precond, weight, tol, pass_tol, maxiter, "
                       "compliance, damping, mu, mu_roll, mu_twist, rows, active_set, sweeps, "
-                      "sweep_tol, sweep_cg, wall, export)",
+                      "sweep_tol, sweep_cg, recovery_speed, wall, export)",
                       &key);
     i += used;
   }
@@ -209,6 +221,10 @@ std::string describe(const Settings &s)
     out += "auto (" + format_g(c.factor) + " dt^2 / m_min)";
   else
     out += format_g(c.eps_n) + " " + format_g(c.eps_t);
+  const double v = s.model.recovery_speed;
+  out += ", recovery_speed " + (v < 0 ? "auto (" + format_g(s.model.recovery_radii) + " r_min / dt)"
+                                : v == 0 ? std::string("none")
+                                         : format_g(v));
   const FrictionParams &f = s.model.friction;
   return out + ", mu " + format_g(f.mu) + ", mu_roll " + format_g(f.mu_roll) + ", mu_twist " +
          format_g(f.mu_twist);

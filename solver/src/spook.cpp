@@ -36,7 +36,7 @@ Vector spook_rhs(const ContactSystem &sys, const Vector *extra_dv)
   b = -b;
   for (int c = 0; c < sys.num_contacts(); ++c) {
     const Eigen::Index row = Eigen::Index(sys.rows()) * c; // normal row
-    if (sys.row_active(row)) b[row] -= 4.0 / p.h * ups * sys.contacts()[c].gap;
+    if (sys.row_active(row)) b[row] += p.gap_term(sys.contacts()[c].gap);
   }
   return b;
 }

@@ -93,8 +93,14 @@ class Reader {
   void keyword(std::vector<std::string_view> &tokens, const char *word, std::size_t values,
                const char *usage)
   {
+    keyword(tokens, word, values, values, usage);
+  }
+  // A keyword line with between min_values and max_values values.
+  void keyword(std::vector<std::string_view> &tokens, const char *word, std::size_t min_values,
+               std::size_t max_values, const char *usage)
+  {
     need(tokens, std::string("'") + usage + "'");
-    if (tokens[0] != word || tokens.size() != values + 1)
+    if (tokens[0] != word || tokens.size() < min_values + 1 || tokens.size() > max_values + 1)
       fail(std::string("expected '") + usage + "', found '" + excerpt(joined(tokens)) + "'");
   }
 
@@ -189,6 +195,8 @@ void write_system(std::ostream &out, const ContactSystem &sys)
   put_real(s, sys.params().h);
   s += ' ';
   put_real(s, sys.params().damping);
+  s += ' ';
+  put_real(s, sys.params().max_recovery);
   s += "\nbodies " + std::to_string(sys.num_bodies()) + " " +
        std::to_string(sys.num_owned_bodies()) + "\n";
   out << s;
@@ -258,10 +266,16 @@ ContactSystem parse_system(std::string_view text)
   const long long rows = in.integer(t[1], "rows");
   if (rows != 3 && rows != 6) in.fail("rows must be 3 or 6, not " + std::to_string(rows));
 
-  in.keyword(t, "spook", 2, "spook <h> <damping>");
+  // version 2 may add the bound of the overlap recovery speed (0, unbounded, when absent)
+  if (version == 1)
+    in.keyword(t, "spook", 2, "spook <h> <damping>");
+  else
+    in.keyword(t, "spook", 2, 3, "spook <h> <damping> [max_recovery]");
   SpookParams params;
   params.h = in.real(t[1], "time step h");
   params.damping = in.real(t[2], "damping");
+  if (t.size() == 4) params.max_recovery = in.real(t[3], "max_recovery");
+  if (!(params.max_recovery >= 0)) in.fail("max_recovery must be non-negative");
   if (!(params.h > 0)) in.fail("time step h must be positive");
   if (!(params.damping >= 0)) in.fail("damping must be non-negative");
 

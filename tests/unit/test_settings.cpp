@@ -58,7 +58,8 @@ TEST(Settings, NoKeywordsKeepTheDefaults)
   EXPECT_EQ(describe(s),
             "form body, solver cg, precond tree, weight z, tol 0.0001, pass_tol 0.001, maxiter "
             "200, active_set 1, sweeps 50, sweep_tol 0.001, rows 6, damping 2, compliance auto "
-            "(0.01 dt^2 / m_min), mu 0.5, mu_roll 0, mu_twist 0");
+            "(0.01 dt^2 / m_min), recovery_speed auto (0.01 r_min / dt), mu 0.5, mu_roll 0, "
+            "mu_twist 0");
 }
 
 TEST(Settings, EveryKeywordSetsWhatItNames)
@@ -97,6 +98,11 @@ TEST(Settings, EveryKeywordSetsWhatItNames)
   EXPECT_EQ(s.export_prefix, "out/sys");
   EXPECT_NE(describe(s).find("compliance 1e-07 2e-07"), std::string::npos);
   EXPECT_EQ(parse_settings(words("solver pgs")).step.solver, Method::pgs);
+  EXPECT_DOUBLE_EQ(parse_settings(words("recovery_speed 0.3")).model.recovery_speed, 0.3);
+  EXPECT_DOUBLE_EQ(parse_settings(words("recovery_speed none")).model.recovery_speed, 0.0);
+  const ContactModel automatic = parse_settings(words("recovery_speed auto")).model;
+  EXPECT_DOUBLE_EQ(automatic.max_recovery(0.01, 0.5), 0.01 * 0.5 / 0.01);
+  EXPECT_DOUBLE_EQ(parse_settings(words("recovery_speed 0.3")).model.max_recovery(0.01, 0.5), 0.3);
   EXPECT_EQ(parse_settings(words("solver mumps")).step.solver, Method::direct);
 }
 
@@ -132,6 +138,8 @@ TEST(Settings, BadInputNamesTheKeywordAndItsForm)
   EXPECT_EQ(error_of("sweeps -1"), "expected 'sweeps <non-negative integer>', got '-1'");
   EXPECT_EQ(error_of("mu -0.1"), "expected 'mu <non-negative number>', got '-0.1'");
   EXPECT_EQ(error_of("rows 4"), "expected 'rows 3|6', got '4'");
+  EXPECT_EQ(error_of("recovery_speed -1"),
+            "expected 'recovery_speed auto|none|<positive speed>', got '-1'");
   EXPECT_EQ(error_of("compliance 1e-6"),
             "expected 'compliance auto' or 'compliance <eps_n> <eps_t>' (positive numbers)");
   EXPECT_EQ(error_of("wall zplane NULL NULL"),

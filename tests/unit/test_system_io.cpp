@@ -165,7 +165,9 @@ TEST(SystemIo, VersionOneAndFrictionFields)
   bool in_contacts = false;
   int left = 0;
   while (std::getline(in, line)) {
-    if (line.rfind("contacts ", 0) == 0) {
+    if (line.rfind("spook ", 0) == 0) {
+      line = line.substr(0, line.rfind(' ')); // version 1 has no recovery bound
+    } else if (line.rfind("contacts ", 0) == 0) {
       in_contacts = true;
       left = sys.num_contacts();
     } else if (in_contacts && left > 0) {
@@ -236,7 +238,8 @@ TEST(SystemIo, EachMalformedInputGetsItsOwnError)
   expect_error(edit(0, "fibre_contact_system one"), {"'one' is not an integer"});
   expect_error(edit(2, "rows 4"), {"rows must be 3 or 6"});
   expect_error(edit(3, "spook 0 2"), {"time step h must be positive"});
-  expect_error(edit(3, "spook"), {"expected 'spook <h> <damping>'"});
+  expect_error(edit(3, "spook"), {"expected 'spook <h> <damping> [max_recovery]'"});
+  expect_error(edit(3, "spook 0.1 2 -1"), {"max_recovery must be non-negative"});
 
   // Truncation: between lines, in the middle of one, and early (a count then claims more
   // than the rest of the input holds).

@@ -24,6 +24,15 @@ struct ContactModel {
   double damping = 2.0; // SPOOK d = tau / h, in steps
   ComplianceParams compliance{};
   FrictionParams friction{}; // of every contact (one material)
+  // The largest speed at which overlaps are removed (SpookParams::max_recovery): > 0 a speed,
+  // 0 unbounded, < 0 (the default) automatic: recovery_radii radii of the smallest sphere per
+  // step, so that an overlap of 10% of a radius closes over 10 steps whatever the units.
+  double recovery_speed = -1.0;
+  double recovery_radii = 0.01;
+  double max_recovery(double h, double r_min) const
+  {
+    return recovery_speed >= 0 ? recovery_speed : recovery_radii * r_min / h;
+  }
 };
 
 // r_eff = ra rb / (ra + rb) for a pair, ra against a wall (b == nullptr).

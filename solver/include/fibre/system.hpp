@@ -77,6 +77,16 @@ struct ContactKinematics {
 struct SpookParams {
   double h = 1e-3;      // time step
   double damping = 2.0; // d = tau / h, in steps (thesis uses tau = 2h)
+  // The largest separation speed the gap term of the rhs may ask for, (4 / h) Upsilon |g| of
+  // an overlap g < 0: deep overlaps are removed over several steps instead of launching the
+  // bodies (Chrono's maximum penetration recovery speed). 0: unbounded.
+  double max_recovery = 0.0;
+  // The gap term of the normal row's rhs, -(4 / h) Upsilon g, bounded by max_recovery.
+  double gap_term(double gap) const
+  {
+    const double term = -4.0 / h * upsilon() * gap;
+    return max_recovery > 0 && term > max_recovery ? max_recovery : term;
+  }
   double upsilon() const { return 1.0 / (1.0 + 4.0 * damping); }
   // Sigma entry for compliance eps: 4 eps / (h^2 (1 + 4 d)).
   double sigma(double eps) const { return 4.0 * eps / (h * h * (1.0 + 4.0 * damping)); }
