@@ -10,7 +10,9 @@
 #include <vector>
 
 #include "fibre/accuracy_study.hpp"
+#include "fibre/pgs.hpp"
 #include "fibre/settings.hpp"
+#include "fibre/spook.hpp"
 #include "fibre/text.hpp"
 
 using namespace fibre;
@@ -36,6 +38,10 @@ options:
   --repeat N            time each setting N times, keep the fastest (default 3)
   --target X            complementarity residual of the reference (default 1e-10)
   --csv FILE            also write the table as CSV
+  --newton-basin        instead of the table: how far the exact semismooth Newton method
+                        (nonsmooth_reference.hpp: sparse LU, line search) gets in 8 iterations
+                        from the warm start and from projected Gauss-Seidel iterates at
+                        complementarity residuals 1e-2, 1e-3 and 1e-4
   --help                this text
 )";
 
@@ -57,6 +63,7 @@ struct Options {
   std::vector<std::string> settings;
   int repeat = 3;
   double target = 1e-10;
+  bool newton_basin = false;
 };
 
 std::vector<std::string> words(const std::string &text)
@@ -83,6 +90,8 @@ bool parse_args(int argc, char **argv, Options &opt)
       ++i;
     } else if (a == "--target" && has && to_double(argv[i + 1], opt.target) && opt.target > 0) {
       ++i;
+    } else if (a == "--newton-basin") {
+      opt.newton_basin = true;
     } else if (a == "--csv" && has) {
       opt.csv = argv[++i];
     } else if (a.rfind("--", 0) != 0 && opt.state.empty()) {
@@ -110,12 +119,45 @@ void print_row(const char *name, const StudyRow &r, std::FILE *csv)
                  e.lambda_t, e.lambda_roll, e.lambda_twist);
 }
 
+// Where Newton converges: it is the reference's second method, and a candidate to finish a
+// step, but only if it converges from where a cheap solver leaves the impulses.
+void newton_basin(const StepState &state)
+{
+  const ContactSystem &sys = state.sys;
+  const Cones cones(sys);
+  const Vector b = spook_rhs(sys);
+  const std::vector<Vec6> scale = row_scales(sys);
+  std::printf("exact semismooth Newton, complementarity residual after each iteration:\n");
+  for (const double start : {0.0, 1e-2, 1e-3, 1e-4}) {
+    Vector lambda = state.warm;
+    for (int c = 0; c < sys.num_contacts(); ++c) cones.project(lambda.data() + sys.rows() * c, c);
+    int sweeps = 0;
+    double r = complementarity(sys, serial_exchange(), cones, b, lambda, scale);
+    while (start > 0 && r > start && sweeps < 100000) {
+      pgs(sys, serial_exchange(), cones, b, scale, lambda, PgsControl{10, 0.0, 1 << 30});
+      sweeps += 10;
+      r = complementarity(sys, serial_exchange(), cones, b, lambda, scale);
+    }
+    std::printf("from the warm start + %5d sweeps (%.1e):", sweeps, r);
+    for (int it = 0; it < 8; ++it) {
+      const NewtonResult nr = semismooth_newton(sys, cones, b, lambda, 1e-10, 1);
+      std::printf(" %.1e", nr.complementarity);
+      if (nr.converged) break;
+    }
+    std::printf("\n");
+  }
+}
+
 int run(const Options &opt)
 {
   const StepState state = read_step_state(opt.state);
   const ContactSystem &sys = state.sys;
   std::printf("state %s: %d bodies, %d contacts, %d rows each\n", opt.state.c_str(),
               sys.num_bodies(), sys.num_contacts(), sys.rows());
+  if (opt.newton_basin) {
+    newton_basin(state);
+    return 0;
+  }
   const auto t0 = Clock::now();
   const Reference ref =
       nonsmooth_reference(sys, state.lambda, ReferenceOptions{opt.target, 2000000, 30});
