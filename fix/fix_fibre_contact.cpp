@@ -213,6 +213,17 @@ void FixFibreContact::smallest_body(const std::vector<fibre::Body> &bodies)
   if (std::isfinite(m[1])) r_min_ = m[1];
 }
 
+// Approach speeds at or below this are plastic (ContactModel::bounce_speed); the automatic rule
+// reads the external forces of every process.
+double FixFibreContact::bounce_speed(const std::vector<fibre::Body> &bodies) const
+{
+  const fibre::ContactModel &model = settings_.model;
+  if (model.restitution <= 0 || model.bounce_speed >= 0) return std::max(model.bounce_speed, 0.0);
+  double v = fibre::external_speed_per_step(bodies, exchange_->num_owned(), dtv_);
+  MPI_Allreduce(MPI_IN_PLACE, &v, 1, MPI_DOUBLE, MPI_MAX, world);
+  return model.bounce_steps * v;
+}
+
 // At the first step of a run: overlaps deeper than kDeepOverlap of the smaller diameter are
 // removed at the recovery speed, over many steps; say so.
 void FixFibreContact::warn_deep_overlaps(const std::vector<fibre::Body> &bodies,
@@ -308,7 +319,8 @@ void FixFibreContact::final_integrate()
   std::vector<fibre::Body> bodies = detection_->bodies();
   std::vector<fibre::DetectedContact> found = detection_->contacts(bodies, dtv_, model.damping);
   smallest_body(bodies);
-  const fibre::SpookParams params{dtv_, model.damping, model.max_recovery(dtv_, r_min_)};
+  fibre::SpookParams params{dtv_, model.damping, model.max_recovery(dtv_, r_min_)};
+  params.bounce_speed = bounce_speed(bodies);
   if (first_step_) warn_deep_overlaps(bodies, found, params.max_recovery);
   first_step_ = false;
   const bool any = output_->count_contacts(found) > 0;

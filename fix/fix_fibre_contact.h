@@ -58,6 +58,7 @@ class FixFibreContact : public Fix {
   void warn_double_integration();
   void check_finite(const char *what, double **array, int nvalues) const;
   void smallest_body(const std::vector<fibre::Body> &bodies);
+  double bounce_speed(const std::vector<fibre::Body> &bodies) const;
   void warn_deep_overlaps(const std::vector<fibre::Body> &bodies,
                           const std::vector<fibre::DetectedContact> &found, double max_recovery);
   fibre::StepResult solve(fibre::ContactSystem &sys, const fibre::Vector &warm);

@@ -1,5 +1,7 @@
 #include "fibre/contact_model.hpp"
 
+#include <algorithm>
+
 namespace fibre {
 
 double effective_radius(const std::vector<Body> &bodies, const Contact &c)
@@ -27,7 +29,15 @@ void apply_contact_model(const ContactModel &model, double h, double m_min,
     c.compliance[1] = c.compliance[2] = eps_t;
     for (int r = 3; r < kMaxRows; ++r) c.compliance[r] = eps_t / (reff * reff);
     c.friction = model.friction;
+    c.restitution = model.restitution;
   }
+}
+
+double external_speed_per_step(const std::vector<Body> &bodies, int num_owned, double h)
+{
+  double v = 0.0;
+  for (int i = 0; i < num_owned; ++i) v = std::max(v, h * bodies[i].force.norm() / bodies[i].mass);
+  return v;
 }
 
 } // namespace fibre

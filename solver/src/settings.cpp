@@ -165,6 +165,25 @@ std::size_t read_model_keyword(const Reader &in, std::size_t i, Settings &s)
       s.model.recovery_speed = in.positive(i + 1, e);
     return 2;
   }
+  if (key == "restitution") {
+    const std::string e = "'restitution <number in [0, 1]>'";
+    const double v = in.number(i + 1, e);
+    if (!(v >= 0.0 && v <= 1.0)) Reader::illegal(e, &in.at(i + 1));
+    s.model.restitution = v;
+    return 2;
+  }
+  if (key == "bounce_speed") {
+    const std::string e = "'bounce_speed auto|<non-negative speed>'";
+    if (!in.has(i + 1)) Reader::illegal(e);
+    if (in.at(i + 1) == "auto") {
+      s.model.bounce_speed = -1.0;
+      return 2;
+    }
+    const double v = in.number(i + 1, e);
+    if (!(v >= 0.0)) Reader::illegal(e, &in.at(i + 1));
+    s.model.bounce_speed = v;
+    return 2;
+  }
   if (key == "rows") {
     const std::string e = "'rows 3|6'";
     long v = 0;
@@ -202,7 +221,8 @@ Settings parse_settings(const std::vector<std::string> &args)
     if (!used)
       Reader::illegal("a keyword (form, solver, precond, weight, tol, pass_tol, maxiter, "
                       "compliance, damping, mu, mu_roll, mu_twist, rows, active_set, sweeps, "
-                      "sweep_tol, sweep_cg, recovery_speed, wall, export)",
+                      "sweep_tol, sweep_cg, recovery_speed, restitution, bounce_speed, "
+                      "wall, export)",
                       &key);
     i += used;
   }
@@ -225,6 +245,9 @@ std::string describe(const Settings &s)
   out += ", recovery_speed " + (v < 0 ? "auto (" + format_g(s.model.recovery_radii) + " r_min / dt)"
                                 : v == 0 ? std::string("none")
                                          : format_g(v));
+  const double vb = s.model.bounce_speed;
+  out += ", restitution " + format_g(s.model.restitution) + ", bounce_speed " +
+         (vb < 0 ? "auto (" + format_g(s.model.bounce_steps) + " dt |f| / m max)" : format_g(vb));
   const FrictionParams &f = s.model.friction;
   return out + ", mu " + format_g(f.mu) + ", mu_roll " + format_g(f.mu_roll) + ", mu_twist " +
          format_g(f.mu_twist);

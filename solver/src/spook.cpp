@@ -1,5 +1,7 @@
 #include "fibre/spook.hpp"
 
+#include <algorithm>
+
 #include "fibre/kernels.hpp"
 
 namespace fibre {
@@ -34,9 +36,34 @@ Vector spook_rhs(const ContactSystem &sys, const Vector *extra_dv)
   Vector b;
   g_apply(sys, w, b);
   b = -b;
+  Vector Gv; // the normal approach speeds, where a contact can bounce
+  for (const Contact &k : sys.contacts())
+    if (k.restitution > 0) {
+      g_apply(sys, body_velocities(sys), Gv);
+      break;
+    }
   for (int c = 0; c < sys.num_contacts(); ++c) {
     const Eigen::Index row = Eigen::Index(sys.rows()) * c; // normal row
-    if (sys.row_active(row)) b[row] += p.gap_term(sys.contacts()[c].gap);
+    if (!sys.row_active(row)) continue;
+    const Contact &k = sys.contacts()[c];
+    const double b_spook = b[row] + p.gap_term(k.gap);
+    // Row: G_n v+ + eps lambda_n = G_n (v + h M^-1 f) + b_n, so b_n = 0 is free flight and
+    // Newton's law G_n v+ = -e vn (vn = G_n v) is b_n = b_n(no gap) - (Upsilon + e) vn.
+    // A contact that bounces keeps its approach speed until the step in which it closes:
+    // SPOOK alone would brake it a step early (b > 0 asks for more than free flight).
+    const double vn = Gv.size() ? Gv[row] : 0.0;
+    const bool bounces = k.restitution > 0 && -vn > p.bounce_speed;
+    if (bounces && k.gap + p.h * vn <= 0) {
+      // The compliance would keep Sigma / (w + Sigma) of the jump, w = 1/m_a + 1/m_b the
+      // row's G M^-1 G^T: ask for that much more (exact for an isolated contact).
+      const double w =
+          1.0 / sys.bodies()[k.a].mass + (k.is_wall() ? 0.0 : 1.0 / sys.bodies()[k.b].mass);
+      const double jump = (b[row] - (ups + k.restitution) * vn) * (1.0 + sys.sigma()[row] / w);
+      b[row] = std::max(b_spook, jump);
+    } else if (bounces && k.gap > 0)
+      b[row] = std::min(b_spook, 0.0);
+    else
+      b[row] = b_spook;
   }
   return b;
 }

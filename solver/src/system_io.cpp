@@ -18,7 +18,8 @@ namespace {
 constexpr const char *kMagic = "fibre_contact_system";
 constexpr int kBodyFields = 17;
 constexpr int kContactFieldsV1 = 2 + 12 + 1 + kMaxRows;
-constexpr int kContactFields = kContactFieldsV1 + 3; // version 2: + mu, mu_roll, mu_twist
+constexpr int kContactFieldsV2 = kContactFieldsV1 + 3; // + mu, mu_roll, mu_twist
+constexpr int kContactFields = kContactFieldsV2 + 1;   // version 3: + restitution
 // Unit vectors must read back as unit vectors; exported data are far more exact than this.
 constexpr double kUnitTol = 1e-6;
 
@@ -197,6 +198,8 @@ void write_system(std::ostream &out, const ContactSystem &sys)
   put_real(s, sys.params().damping);
   s += ' ';
   put_real(s, sys.params().max_recovery);
+  s += ' ';
+  put_real(s, sys.params().bounce_speed);
   s += "\nbodies " + std::to_string(sys.num_bodies()) + " " +
        std::to_string(sys.num_owned_bodies()) + "\n";
   out << s;
@@ -219,7 +222,7 @@ void write_system(std::ostream &out, const ContactSystem &sys)
       s += ' ';
       put_real(s, eps);
     }
-    for (double f : {c.friction.mu, c.friction.mu_roll, c.friction.mu_twist}) {
+    for (double f : {c.friction.mu, c.friction.mu_roll, c.friction.mu_twist, c.restitution}) {
       s += ' ';
       put_real(s, f);
     }
@@ -257,25 +260,32 @@ ContactSystem parse_system(std::string_view text)
     in.fail(std::string("not a fibre_contact system file (expected '") + kMagic +
             " <version>', found '" + excerpt(t[0]) + "')");
   const long long version = in.integer(t[1], "format version");
-  if (version != 1 && version != kSystemFormatVersion)
-    in.fail("unsupported format version " + std::to_string(version) + " (this reader knows 1 and " +
+  if (version < 1 || version > kSystemFormatVersion)
+    in.fail("unsupported format version " + std::to_string(version) + " (this reader knows 1 to " +
             std::to_string(kSystemFormatVersion) + ")");
-  const int contact_fields = version == 1 ? kContactFieldsV1 : kContactFields;
+  const int contact_fields = version == 1   ? kContactFieldsV1
+                             : version == 2 ? kContactFieldsV2
+                                            : kContactFields;
 
   in.keyword(t, "rows", 1, "rows <3|6>");
   const long long rows = in.integer(t[1], "rows");
   if (rows != 3 && rows != 6) in.fail("rows must be 3 or 6, not " + std::to_string(rows));
 
-  // version 2 may add the bound of the overlap recovery speed (0, unbounded, when absent)
+  // version 2 may add the bound of the overlap recovery speed (0, unbounded, when absent),
+  // version 3 also the bounce speed (0 when absent)
   if (version == 1)
     in.keyword(t, "spook", 2, "spook <h> <damping>");
-  else
+  else if (version == 2)
     in.keyword(t, "spook", 2, 3, "spook <h> <damping> [max_recovery]");
+  else
+    in.keyword(t, "spook", 2, 4, "spook <h> <damping> [max_recovery [bounce_speed]]");
   SpookParams params;
   params.h = in.real(t[1], "time step h");
   params.damping = in.real(t[2], "damping");
-  if (t.size() == 4) params.max_recovery = in.real(t[3], "max_recovery");
+  if (t.size() >= 4) params.max_recovery = in.real(t[3], "max_recovery");
+  if (t.size() >= 5) params.bounce_speed = in.real(t[4], "bounce_speed");
   if (!(params.max_recovery >= 0)) in.fail("max_recovery must be non-negative");
+  if (!(params.bounce_speed >= 0)) in.fail("bounce_speed must be non-negative");
   if (!(params.h > 0)) in.fail("time step h must be positive");
   if (!(params.damping >= 0)) in.fail("damping must be non-negative");
 
@@ -346,6 +356,10 @@ ContactSystem parse_system(std::string_view text)
       *coeff[i] = in.real(t[kContactFieldsV1 + i], what + name[i]);
       if (*coeff[i] < 0) in.fail(what + ":" + name[i] + " must not be negative");
     }
+    if (version == 2) continue;
+    k.restitution = in.real(t[kContactFieldsV2], what + " restitution");
+    if (!(k.restitution >= 0 && k.restitution <= 1))
+      in.fail(what + ": restitution must be in [0, 1]");
   }
 
   const long long dofs = rows * nc;

@@ -58,8 +58,8 @@ TEST(Settings, NoKeywordsKeepTheDefaults)
   EXPECT_EQ(describe(s),
             "form body, solver cg, precond tree, weight z, tol 0.0001, pass_tol 0.001, maxiter "
             "200, active_set 1, sweeps 50, sweep_tol 0.001, rows 6, damping 2, compliance auto "
-            "(0.01 dt^2 / m_min), recovery_speed auto (0.01 r_min / dt), mu 0.5, mu_roll 0, "
-            "mu_twist 0");
+            "(0.01 dt^2 / m_min), recovery_speed auto (0.01 r_min / dt), restitution 0, "
+            "bounce_speed auto (2 dt |f| / m max), mu 0.5, mu_roll 0, mu_twist 0");
 }
 
 TEST(Settings, EveryKeywordSetsWhatItNames)
@@ -140,6 +140,12 @@ TEST(Settings, BadInputNamesTheKeywordAndItsForm)
   EXPECT_EQ(error_of("rows 4"), "expected 'rows 3|6', got '4'");
   EXPECT_EQ(error_of("recovery_speed -1"),
             "expected 'recovery_speed auto|none|<positive speed>', got '-1'");
+  EXPECT_EQ(error_of("restitution 1.5"), "expected 'restitution <number in [0, 1]>', got '1.5'");
+  EXPECT_EQ(error_of("restitution"), "expected 'restitution <number in [0, 1]>'");
+  EXPECT_EQ(error_of("bounce_speed -2"),
+            "expected 'bounce_speed auto|<non-negative speed>', got '-2'");
+  EXPECT_EQ(parse_settings(words("restitution 0.5 bounce_speed 0.2")).model.restitution, 0.5);
+  EXPECT_EQ(parse_settings(words("restitution 0.5 bounce_speed 0.2")).model.bounce_speed, 0.2);
   EXPECT_EQ(error_of("compliance 1e-6"),
             "expected 'compliance auto' or 'compliance <eps_n> <eps_t>' (positive numbers)");
   EXPECT_EQ(error_of("wall zplane NULL NULL"),

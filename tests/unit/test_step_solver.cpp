@@ -220,6 +220,42 @@ TEST(ContactSolver, SeparatingPairIsReleased)
   }
 }
 
+// Newton's impact law: a head-on pair (unequal masses, closing within the step) separates at
+// e times its approach speed with its momentum kept; e = 0 stays plastic (SPOOK alone: the
+// pair stops approaching); an approach at or below bounce_speed is plastic whatever e.
+TEST(ContactSolver, RestitutionHeadOnPair)
+{
+  for (double e : {0.0, 0.3, 0.5, 0.9}) {
+    for (double speed : {2.0, 0.05}) {
+      std::vector<Body> bodies{sphere(1.0, 1.0, Vec3(0, 0, 2.00001)),
+                               sphere(3.0, 1.0, Vec3::Zero())};
+      for (Body &b : bodies) b.force.setZero();
+      bodies[0].v = Vec3(0, 0, -speed);
+      bodies[1].v = Vec3(0, 0, speed / 3.0);
+      std::vector<Contact> contacts{sphere_sphere_contact(bodies, 0, 1)};
+      contacts[0].restitution = e;
+      for (Contact &c : contacts) c.compliance.fill(1e-14);
+      SpookParams p = spook();
+      p.bounce_speed = 0.1;
+      ContactSystem sys(bodies, contacts, 6, p);
+      const double approach = speed + speed / 3.0;
+      SCOPED_TRACE("e " + std::to_string(e) + " speed " + std::to_string(speed));
+      const StepResult res = solve(sys, base_options());
+      const double va = -speed + res.dv[2], vb = speed / 3.0 + res.dv[8];
+      const double separation = va - vb;
+      EXPECT_NEAR(1.0 * res.dv[2] + 3.0 * res.dv[8], 0.0, 1e-12); // momentum
+      if (speed > p.bounce_speed && e > 0) {
+        EXPECT_NEAR(separation, e * approach, 1e-6 * approach);
+      } else {
+        // plastic: SPOOK's target, Upsilon of the approach plus closing the 1e-5 gap
+        const double gap = sys.contacts()[0].gap;
+        ASSERT_LT(gap + p.h * -approach, 0.0); // the pair closes within the step
+        EXPECT_NEAR(separation, -p.upsilon() * (approach + 4.0 / p.h * gap), 1e-6 * approach);
+      }
+    }
+  }
+}
+
 // Body-body contacts only: the impulses are internal, momentum and angular momentum stay.
 TEST(ContactSolver, ConservesMomentum)
 {

@@ -25,6 +25,8 @@ ContactSystem sample_system(int rows = 6)
   p.rows = rows;
   p.spook.h = 1.0 / 3.0e3;
   p.spook.damping = 2.5;
+  p.spook.max_recovery = 0.125;
+  p.spook.bounce_speed = 0.25;
   const ContactSystem pile = pile_scene(25, p);
   std::vector<Body> bodies = pile.bodies();
   bodies[0].v = Vec3(-0.0, 1e-310, 0.1); // signed zero and a subnormal
@@ -32,6 +34,7 @@ ContactSystem sample_system(int rows = 6)
   std::vector<Contact> contacts = pile.contacts();
   contacts[0].compliance = {1e-8, 2e-8, 3e-8, 4e-8, 5e-8, 6e-8};
   contacts[1].friction = FrictionParams{0.3, 1.0 / 3.0, 0.0}; // per contact since version 2
+  contacts[1].restitution = 0.7;                               // since version 3
   ContactSystem sys(bodies, contacts, rows, p.spook, pile.num_bodies() - 4);
   std::vector<unsigned char> mask(sys.contact_dofs(), 1);
   for (std::size_t r = 2; r < mask.size(); r += 7) mask[r] = 0;
@@ -57,6 +60,8 @@ void expect_identical(const ContactSystem &a, const ContactSystem &b)
   EXPECT_EQ(a.num_owned_bodies(), b.num_owned_bodies());
   EXPECT_EQ(a.params().h, b.params().h);
   EXPECT_EQ(a.params().damping, b.params().damping);
+  EXPECT_EQ(a.params().max_recovery, b.params().max_recovery);
+  EXPECT_EQ(a.params().bounce_speed, b.params().bounce_speed);
   // Bitwise: memcmp-like equality, so that -0.0 and 0.0 differ.
   auto same = [](double x, double y) { return std::signbit(x) == std::signbit(y) && x == y; };
   auto same3 = [&](const Vec3 &x, const Vec3 &y) {
@@ -75,7 +80,7 @@ void expect_identical(const ContactSystem &a, const ContactSystem &b)
                 same3(p.t2, q.t2) && same3(p.point, q.point) && same(p.gap, q.gap) &&
                 p.compliance == q.compliance && p.friction.mu == q.friction.mu &&
                 p.friction.mu_roll == q.friction.mu_roll &&
-                p.friction.mu_twist == q.friction.mu_twist)
+                p.friction.mu_twist == q.friction.mu_twist && p.restitution == q.restitution)
         << "contact " << c;
   }
   EXPECT_EQ(a.row_mask(), b.row_mask());
@@ -146,49 +151,69 @@ TEST(SystemIo, RoundTripIsExact)
   for (int rows : {6, 3}) {
     const ContactSystem sys = sample_system(rows);
     const std::string text = to_text(sys);
-    EXPECT_EQ(text.rfind("fibre_contact_system 2\n", 0), 0u);
+    EXPECT_EQ(text.rfind("fibre_contact_system 3\n", 0), 0u);
     const ContactSystem back = parse_system(text);
     expect_identical(sys, back);
     EXPECT_EQ(to_text(back), text); // and the writer is deterministic
   }
 }
 
-// Version 1 files (no friction per contact) still read, with the default coefficients; a
-// negative coefficient is an error.
-TEST(SystemIo, VersionOneAndFrictionFields)
+// An older version of the sample: the spook line and each contact line lose their last
+// `drop_spook` and `drop_contact` values.
+std::string older_version(const ContactSystem &sys, int version, int drop_spook, int drop_contact)
 {
-  const ContactSystem sys = sample_system();
-  std::string text = to_text(sys);
-  // drop the three coefficients of every contact line and call it version 1
-  std::istringstream in(text);
-  std::string v1, line;
+  std::istringstream in(to_text(sys));
+  std::string out, line;
   bool in_contacts = false;
   int left = 0;
+  const auto drop = [](std::string &l, int n) {
+    for (int k = 0; k < n; ++k) l = l.substr(0, l.rfind(' '));
+  };
   while (std::getline(in, line)) {
     if (line.rfind("spook ", 0) == 0) {
-      line = line.substr(0, line.rfind(' ')); // version 1 has no recovery bound
+      drop(line, drop_spook);
     } else if (line.rfind("contacts ", 0) == 0) {
       in_contacts = true;
       left = sys.num_contacts();
     } else if (in_contacts && left > 0) {
-      line = line.substr(0, line.rfind(' '));
-      line = line.substr(0, line.rfind(' '));
-      line = line.substr(0, line.rfind(' '));
+      drop(line, drop_contact);
       --left;
     }
-    v1 += line + "\n";
+    out += line + "\n";
   }
-  v1.replace(0, std::string("fibre_contact_system 2").size(), "fibre_contact_system 1");
-  const ContactSystem old = parse_system(v1);
-  ASSERT_EQ(old.num_contacts(), sys.num_contacts());
-  EXPECT_EQ(old.contacts()[1].friction.mu, FrictionParams{}.mu);
-  EXPECT_EQ(old.contacts()[1].friction.mu_roll, FrictionParams{}.mu_roll);
-  EXPECT_EQ(old.contacts()[0].compliance, sys.contacts()[0].compliance);
-  // a version-2 contact line with a negative coefficient
+  out.replace(0, std::string("fibre_contact_system 3").size(),
+              "fibre_contact_system " + std::to_string(version));
+  return out;
+}
+
+// Version 1 files (no friction per contact) and version 2 files (no restitution) still read,
+// with the defaults; a negative coefficient or a restitution above 1 is an error.
+TEST(SystemIo, OlderVersionsAndCoefficientFields)
+{
+  const ContactSystem sys = sample_system();
+  const ContactSystem v1 = parse_system(older_version(sys, 1, 2, 4));
+  ASSERT_EQ(v1.num_contacts(), sys.num_contacts());
+  EXPECT_EQ(v1.contacts()[1].friction.mu, FrictionParams{}.mu);
+  EXPECT_EQ(v1.contacts()[1].friction.mu_roll, FrictionParams{}.mu_roll);
+  EXPECT_EQ(v1.contacts()[1].restitution, 0.0);
+  EXPECT_EQ(v1.contacts()[0].compliance, sys.contacts()[0].compliance);
+  EXPECT_EQ(v1.params().max_recovery, 0.0);
+  const ContactSystem v2 = parse_system(older_version(sys, 2, 1, 1));
+  EXPECT_EQ(v2.contacts()[1].friction.mu, 0.3);
+  EXPECT_EQ(v2.contacts()[1].restitution, 0.0);
+  EXPECT_EQ(v2.params().max_recovery, 0.125);
+  EXPECT_EQ(v2.params().bounce_speed, 0.0);
+  // the first contact line with a negative twisting coefficient, then a restitution of 2
+  std::string text = to_text(sys);
   const std::size_t at = text.find("contacts ");
   const std::size_t end = text.find('\n', text.find('\n', at) + 1);
-  text.replace(end - 1, 1, "-1");
-  expect_error(text, {"contact 0:", "mu_twist must not be negative"});
+  const std::size_t last = text.rfind(' ', end - 1), coeff = text.rfind(' ', last - 1);
+  std::string bad = text;
+  bad.replace(coeff + 1, last - coeff - 1, "-1");
+  expect_error(bad, {"contact 0:", "mu_twist must not be negative"});
+  bad = text;
+  bad.replace(last + 1, end - last - 1, "2");
+  expect_error(bad, {"contact 0:", "restitution must be in [0, 1]"});
 }
 
 TEST(SystemIo, FileRoundTripAndMissingFile)
@@ -234,11 +259,11 @@ TEST(SystemIo, EachMalformedInputGetsItsOwnError)
 
   expect_error("", {"line 1:", "unexpected end of input", "header"});
   expect_error(edit(0, "fibre_contact_sistem 1"), {"line 1:", "not a fibre_contact system"});
-  expect_error(edit(0, "fibre_contact_system 3"), {"unsupported format version 3"});
+  expect_error(edit(0, "fibre_contact_system 4"), {"unsupported format version 4"});
   expect_error(edit(0, "fibre_contact_system one"), {"'one' is not an integer"});
   expect_error(edit(2, "rows 4"), {"rows must be 3 or 6"});
   expect_error(edit(3, "spook 0 2"), {"time step h must be positive"});
-  expect_error(edit(3, "spook"), {"expected 'spook <h> <damping> [max_recovery]'"});
+  expect_error(edit(3, "spook"), {"expected 'spook <h> <damping> [max_recovery [bounce_speed]]'"});
   expect_error(edit(3, "spook 0.1 2 -1"), {"max_recovery must be non-negative"});
 
   // Truncation: between lines, in the middle of one, and early (a count then claims more
@@ -252,7 +277,7 @@ TEST(SystemIo, EachMalformedInputGetsItsOwnError)
     const std::string cut = join(std::vector<std::string>(L.begin(), L.begin() + last)) +
                             L[last].substr(0, L[last].size() / 2);
     expect_error(cut, {line_tag(last), "contact " + std::to_string(sys.num_contacts() - 1) +
-                                           ": expected 24 values"});
+                                           ": expected 25 values"});
     expect_error(text.substr(0, text.size() - 4), {"unexpected end of input", "'end'"});
     std::vector<std::string> early(L.begin(), L.begin() + bodies + 3);
     expect_error(join(early), {line_tag(bodies), "body count 25 is more than the rest"});
@@ -295,7 +320,7 @@ TEST(SystemIo, EachMalformedInputGetsItsOwnError)
   expect_error(edit(contacts + 1, with_token(c0, 2, "2")), {"contact 0 normal is not a unit"});
   expect_error(edit(contacts + 1, with_token(c0, 15, "0")),
                {"contact 0: compliance of row 0 must be positive"});
-  expect_error(edit(contacts + 1, c0 + " 7"), {"contact 0: expected 24 values, found 25"});
+  expect_error(edit(contacts + 1, c0 + " 7"), {"contact 0: expected 25 values, found 26"});
 
   // Anything after the end, and binary junk.
   expect_error(text + "bodies 1 1\n", {"unexpected content after 'end'"});

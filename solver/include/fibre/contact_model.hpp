@@ -33,7 +33,18 @@ struct ContactModel {
   {
     return recovery_speed >= 0 ? recovery_speed : recovery_radii * r_min / h;
   }
+  // Newton's coefficient of restitution of every contact (0: plastic, the SPOOK default), and
+  // the approach speed below which contacts stay plastic (SpookParams::bounce_speed): >= 0 a
+  // speed, < 0 (the default) automatic, bounce_steps times the largest speed that the external
+  // forces add to a body in one step.
+  double restitution = 0.0;
+  double bounce_speed = -1.0;
+  double bounce_steps = 2.0;
 };
+
+// The automatic bounce speed's scale: max over bodies of h |f| / m (local; a front end takes
+// the maximum over processes).
+double external_speed_per_step(const std::vector<Body> &bodies, int num_owned, double h);
 
 // r_eff = ra rb / (ra + rb) for a pair, ra against a wall (b == nullptr).
 inline double effective_radius(double ra, const double *rb)
@@ -45,7 +56,7 @@ double effective_radius(const std::vector<Body> &bodies, const Contact &c);
 // Cone radius per unit normal impulse of cone k (0 Coulomb, 1 twisting, 2 rolling).
 double cone_coefficient(const FrictionParams &f, double r_eff, int cone);
 
-// Sets the per-row compliance and the friction coefficients of every contact (m_min: the
+// Sets the per-row compliance, the friction coefficients and the restitution of every contact (m_min: the
 // lightest body of the simulation, read by automatic compliance only).
 void apply_contact_model(const ContactModel &model, double h, double m_min,
                          const std::vector<Body> &bodies, std::vector<Contact> &contacts);

@@ -51,6 +51,9 @@ struct Contact {
   double gap = 0.0;                          // signed distance, negative = overlap
   std::array<double, kMaxRows> compliance{}; // per-row eps (1/stiffness)
   FrictionParams friction{};
+  // Newton's impact law on the normal row: a contact that closes within the step at a speed
+  // above SpookParams::bounce_speed separates at restitution times that speed. 0: plastic.
+  double restitution = 0.0;
   bool is_wall() const { return b < 0; }
 };
 
@@ -81,6 +84,9 @@ struct SpookParams {
   // an overlap g < 0: deep overlaps are removed over several steps instead of launching the
   // bodies (Chrono's maximum penetration recovery speed). 0: unbounded.
   double max_recovery = 0.0;
+  // Approach speeds at or below this are plastic whatever the contact's restitution (resting
+  // contacts must not bounce on the speed gravity adds in a step).
+  double bounce_speed = 0.0;
   // The gap term of the normal row's rhs, -(4 / h) Upsilon g, bounded by max_recovery.
   double gap_term(double gap) const
   {

@@ -32,7 +32,8 @@
 
 namespace fibre {
 
-inline constexpr int kSystemFormatVersion = 2; // 2: friction per contact; 1 is read too
+// 2: friction per contact; 3: restitution per contact and the bounce speed. 1 and 2 are read.
+inline constexpr int kSystemFormatVersion = 3;
 
 void write_system(std::ostream &out, const ContactSystem &sys);
 // Throws std::runtime_error when the file cannot be written.
