@@ -34,7 +34,7 @@ ContactSystem sample_system(int rows = 6)
   std::vector<Contact> contacts = pile.contacts();
   contacts[0].compliance = {1e-8, 2e-8, 3e-8, 4e-8, 5e-8, 6e-8};
   contacts[1].friction = FrictionParams{0.3, 1.0 / 3.0, 0.0}; // per contact since version 2
-  contacts[1].restitution = 0.7;                               // since version 3
+  contacts[1].restitution = 0.7;                              // since version 3
   ContactSystem sys(bodies, contacts, rows, p.spook, pile.num_bodies() - 4);
   std::vector<unsigned char> mask(sys.contact_dofs(), 1);
   for (std::size_t r = 2; r < mask.size(); r += 7) mask[r] = 0;

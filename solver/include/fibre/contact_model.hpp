@@ -56,8 +56,8 @@ double effective_radius(const std::vector<Body> &bodies, const Contact &c);
 // Cone radius per unit normal impulse of cone k (0 Coulomb, 1 twisting, 2 rolling).
 double cone_coefficient(const FrictionParams &f, double r_eff, int cone);
 
-// Sets the per-row compliance, the friction coefficients and the restitution of every contact (m_min: the
-// lightest body of the simulation, read by automatic compliance only).
+// Sets the per-row compliance, the friction coefficients and the restitution of every contact
+// (m_min: the lightest body of the simulation, read by automatic compliance only).
 void apply_contact_model(const ContactModel &model, double h, double m_min,
                          const std::vector<Body> &bodies, std::vector<Contact> &contacts);
 
