@@ -19,9 +19,11 @@
 
 #include "atom.h"
 #include "comm.h"
+#include "compute.h"
 #include "domain.h"
 #include "error.h"
 #include "fibre_detect.h"
+#include "fibre/stress.hpp"
 #include "fibre/text.hpp"
 #include "fibre_output.h"
 #include "force.h"
@@ -61,6 +63,9 @@ FixFibreContact::FixFibreContact(LAMMPS *lmp, int narg, char **arg) : Fix(lmp, n
   comm_forward = fibre_lmp::LammpsExchange::kValuesPerAtom;
   comm_reverse = fibre_lmp::LammpsExchange::kValuesPerAtom;
   maxexchange = fibre::ContactHistory::kMaxPacked;
+  // the contact forces' virial enters compute pressure and compute stress/atom
+  virial_global_flag = virial_peratom_flag = 1;
+  thermo_virial = 1;
 
   try {
     settings_ = fibre::parse_settings(std::vector<std::string>(arg + 3, arg + narg));
@@ -102,7 +107,34 @@ FixFibreContact::~FixFibreContact()
 
 int FixFibreContact::setmask()
 {
-  return INITIAL_INTEGRATE | FINAL_INTEGRATE;
+  return INITIAL_INTEGRATE | POST_FORCE | FINAL_INTEGRATE;
+}
+
+/* ----------------------------------------------------------------------
+   the forces come in final_integrate; here only whether this step tallies the virial
+------------------------------------------------------------------------- */
+
+void FixFibreContact::post_force(int vflag)
+{
+  v_init(vflag);
+}
+
+/* ----------------------------------------------------------------------
+   the contact forces' virial, global (this process's contacts) and per owned atom
+------------------------------------------------------------------------- */
+
+void FixFibreContact::tally_virial(const fibre::ContactSystem &sys, const fibre::Vector &lambda)
+{
+  fibre::Virial global;
+  fibre::Vector per_body;
+  fibre::contact_virial(sys, lambda, global, vflag_atom ? &per_body : nullptr);
+  if (vflag_global)
+    for (int i = 0; i < 6; ++i) virial[i] += global[i];
+  if (!vflag_atom) return;
+  exchange_->reverse_sum(per_body);
+  const std::vector<int> &body_atom = exchange_->body_atom();
+  for (int k = 0; k < exchange_->num_owned(); ++k)
+    for (int i = 0; i < 6; ++i) vatom[body_atom[k]][i] += per_body[6 * k + i];
 }
 
 /* ---------------------------------------------------------------------- */
@@ -124,6 +156,23 @@ void FixFibreContact::check_pair_style(bool at_init)
                                   "pair style's force computation is on: define the pair style "
                                   "before fix fibre_contact and do not use 'pair_modify compute "
                                   "yes'"));
+}
+
+// Computes that read the pair style's own forces see none: its force computation is off.
+// compute stress/atom and compute pressure are right (this fix tallies its virial); these are
+// not.
+void FixFibreContact::warn_pair_computes()
+{
+  if (comm->me != 0) return;
+  for (int i = 0; i < modify->ncompute; ++i) {
+    const std::string style = modify->compute[i]->style;
+    if (style == "pair/local" || style == "contact/atom" || style == "pair")
+      error->warning(FLERR, "Fix fibre_contact: compute " + std::string(modify->compute[i]->id) +
+                                " (" + style +
+                                ") reads the pair style, whose forces are switched off: it sees "
+                                "no contact forces (fix fibre_contact's local array f_" +
+                                id + " has them)");
+  }
 }
 
 // Another fix that moves the same atoms would integrate them twice.
@@ -153,13 +202,15 @@ void FixFibreContact::init()
   dtv_ = update->dt;
   detection_->init_walls(settings_.walls);
   warn_double_integration();
+  warn_pair_computes();
   if (comm->me == 0) utils::logmesg(lmp, "fix fibre_contact: " + fibre::describe(settings_) + "\n");
 }
 
 /* ---------------------------------------------------------------------- */
 
-void FixFibreContact::setup(int /*vflag*/)
+void FixFibreContact::setup(int vflag)
 {
+  v_init(vflag); // no contact forces before the run's first step: a zero virial
   first_step_ = true;
   if (!force->pair || !force->pair->list)
     error->all(FLERR, std::string("Fix fibre_contact found no neighbor list of the pair style"));
@@ -339,6 +390,8 @@ void FixFibreContact::final_integrate()
   fibre::StepResult res;
   if (any) res = solve(sys, warm);
   update_velocities(res.dv.size() > 0 ? &res.dv : nullptr);
+  if (evflag) // this step's virial is wanted (post_force)
+    tally_virial(sys, res.lambda.size() ? res.lambda : fibre::Vector::Zero(sys.contact_dofs()));
   overflow_count_ += history_.store(found, res.lambda, model.rows, dtv_, atom->nlocal);
 
   // report

@@ -28,6 +28,7 @@ class FixFibreContact : public Fix {
   void init() override;
   void setup(int) override;
   void initial_integrate(int) override;
+  void post_force(int) override;
   void final_integrate() override;
   void reset_dt() override;
 
@@ -56,9 +57,11 @@ class FixFibreContact : public Fix {
  protected:
   void check_pair_style(bool at_init);
   void warn_double_integration();
+  void warn_pair_computes();
   void check_finite(const char *what, double **array, int nvalues) const;
   void smallest_body(const std::vector<fibre::Body> &bodies);
   double bounce_speed(const std::vector<fibre::Body> &bodies) const;
+  void tally_virial(const fibre::ContactSystem &sys, const fibre::Vector &lambda);
   void warn_deep_overlaps(const std::vector<fibre::Body> &bodies,
                           const std::vector<fibre::DetectedContact> &found, double max_recovery);
   fibre::StepResult solve(fibre::ContactSystem &sys, const fibre::Vector &warm);

@@ -107,6 +107,10 @@ CASES = [
     ("two_d", "", "requires a 3d simulation", {"deck": TWO_D}),
     ("infinite_force", "", "non-finite force of atom 1 at step 1",
      {"pre": "fix push all addforce 0 0 1e400"}),
+    ("restitution", "restitution 1.5", "expected 'restitution <number in [0, 1]>', got '1.5'",
+     {}),
+    ("bounce_speed", "restitution 0.5 bounce_speed fast",
+     "expected 'bounce_speed auto|<non-negative speed>', got 'fast'", {}),
 ]
 
 
@@ -116,6 +120,8 @@ WARN_CASES = [
      "atoms of group all", {"pre": "fix nve all nve/sphere"}),
     ("pair_switched_off", "", "switched off the force computation of pair style gran/hooke",
      {}),
+    ("pair_local", "", "compute pl (pair/local) reads the pair style, whose forces are switched "
+     "off", {"post": "compute pl all pair/local dist"}),
 ]
 
 
