@@ -93,6 +93,7 @@ std::vector<fibre::Body> LammpsDetection::bodies()
     b.omega = vel.segment<3>(6 * k + 3);
     b.force = frc.segment<3>(6 * k);
     b.torque = frc.segment<3>(6 * k + 3);
+    b.type = atom->type[i];
   }
   return out;
 }
@@ -155,6 +156,7 @@ void LammpsDetection::pair_contacts(const std::vector<fibre::Body> &bodies, doub
         fibre::Vec3 n(sign * dx, sign * dy, sign * dz);
         n = dist > 0.0 ? fibre::Vec3(n / dist) : fibre::Vec3::UnitZ();
         fc.contact = fibre::sphere_wall_contact(bodies, atom_body_[g], n, dist - radius[o]);
+        fc.contact.wall_type = atom->type[o];
         if (!fibre::is_contact(bodies[atom_body_[g]], nullptr, n, fc.contact.gap, h, damping))
           continue;
         fc.tag_a = tag[g];

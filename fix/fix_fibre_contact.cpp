@@ -26,6 +26,7 @@
 #include "fibre/stress.hpp"
 #include "fibre/text.hpp"
 #include "fibre_output.h"
+#include "pair_coefficients.h"
 #include "force.h"
 #include "group.h"
 #include "lammps_exchange.h"
@@ -158,6 +159,47 @@ void FixFibreContact::check_pair_style(bool at_init)
                                   "yes'"));
 }
 
+// The friction and restitution coefficients per type pair from the pair style (coefficients
+// pair): logged with what the fix does not use; without usable ones, the keywords' values.
+void FixFibreContact::read_coefficients()
+{
+  fibre::ContactModel &model = settings_.model;
+  model.materials = fibre::MaterialTable();
+  if (model.coefficients != fibre::CoefficientSource::pair) return;
+  const fibre_lmp::PairReading reading = fibre_lmp::read_pair_coefficients(lmp);
+  if (!reading.failure.empty()) {
+    if (comm->me == 0)
+      error->warning(FLERR, "Fix fibre_contact: cannot read the pair style's coefficients (" +
+                                reading.failure +
+                                "); every contact takes the fix's mu, mu_roll, mu_twist and "
+                                "restitution");
+    return;
+  }
+  model.materials = reading.table;
+  if (comm->me != 0) return;
+  bool frictionless = !model.typed.mu;
+  for (int i = 1; i <= reading.table.ntypes(); ++i)
+    for (int j = i; j <= reading.table.ntypes(); ++j)
+      frictionless = frictionless && reading.table.at(i, j).mu == 0.0;
+  if (frictionless)
+    error->warning(FLERR, std::string("Fix fibre_contact: the pair style's friction coefficient "
+                                      "is 0 for every type pair, so every contact is "
+                                      "frictionless (give the fix's mu keyword, or "
+                                      "'coefficients fix', to set it)"));
+  std::string text = "fix fibre_contact: coefficients from pair style " +
+                     std::string(force->pair_style) + " (types i j; walls take i i";
+  const fibre::TypedCoefficients &t = model.typed;
+  if (t.mu || t.mu_roll || t.mu_twist || t.restitution)
+    text += std::string("; overridden by the fix's") + (t.mu ? " mu" : "") +
+            (t.mu_roll ? " mu_roll" : "") + (t.mu_twist ? " mu_twist" : "") +
+            (t.restitution ? " restitution" : "");
+  text += "):\n";
+  for (const std::string &line : fibre_lmp::describe_table(reading.table))
+    text += "  " + line + "\n";
+  for (const std::string &note : reading.notes) text += "  note: " + note + "\n";
+  utils::logmesg(lmp, text);
+}
+
 // Computes that read the pair style's own forces see none: its force computation is off.
 // compute stress/atom and compute pressure are right (this fix tallies its virial); these are
 // not.
@@ -203,6 +245,7 @@ void FixFibreContact::init()
   detection_->init_walls(settings_.walls);
   warn_double_integration();
   warn_pair_computes();
+  read_coefficients();
   if (comm->me == 0) utils::logmesg(lmp, "fix fibre_contact: " + fibre::describe(settings_) + "\n");
 }
 

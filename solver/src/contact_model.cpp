@@ -30,6 +30,18 @@ void apply_contact_model(const ContactModel &model, double h, double m_min,
     for (int r = 3; r < kMaxRows; ++r) c.compliance[r] = eps_t / (reff * reff);
     c.friction = model.friction;
     c.restitution = model.restitution;
+    if (!model.per_type()) continue;
+    const int ta = bodies[c.a].type;
+    const int tb = !c.is_wall() ? bodies[c.b].type : c.wall_type > 0 ? c.wall_type : ta;
+    if (ta < 1 || tb < 1 || ta > model.materials.ntypes() || tb > model.materials.ntypes())
+      continue; // no type: the model's values
+    const PairCoefficients &p = model.materials.at(ta, tb);
+    const FrictionParams f = contact_friction(p, reff, std::max(-c.gap, 0.0));
+    const TypedCoefficients &typed = model.typed;
+    if (!typed.mu) c.friction.mu = f.mu;
+    if (!typed.mu_roll) c.friction.mu_roll = f.mu_roll;
+    if (!typed.mu_twist) c.friction.mu_twist = f.mu_twist;
+    if (!typed.restitution && p.restitution >= 0) c.restitution = p.restitution;
   }
 }
 

@@ -150,7 +150,9 @@ std::size_t read_model_keyword(const Reader &in, std::size_t i, Settings &s)
     const double v = in.number(i + 1, e);
     if (!(v >= 0.0)) Reader::illegal(e, &in.at(i + 1));
     FrictionParams &f = s.model.friction;
+    TypedCoefficients &typed = s.model.typed;
     (key == "mu" ? f.mu : key == "mu_roll" ? f.mu_roll : f.mu_twist) = v;
+    (key == "mu" ? typed.mu : key == "mu_roll" ? typed.mu_roll : typed.mu_twist) = true;
     return 2;
   }
   if (key == "recovery_speed") {
@@ -170,6 +172,11 @@ std::size_t read_model_keyword(const Reader &in, std::size_t i, Settings &s)
     const double v = in.number(i + 1, e);
     if (!(v >= 0.0 && v <= 1.0)) Reader::illegal(e, &in.at(i + 1));
     s.model.restitution = v;
+    s.model.typed.restitution = true;
+    return 2;
+  }
+  if (key == "coefficients") {
+    s.model.coefficients = in.name<CoefficientSource>(i + 1, key);
     return 2;
   }
   if (key == "bounce_speed") {
@@ -222,7 +229,7 @@ Settings parse_settings(const std::vector<std::string> &args)
       Reader::illegal("a keyword (form, solver, precond, weight, tol, pass_tol, maxiter, "
                       "compliance, damping, mu, mu_roll, mu_twist, rows, active_set, sweeps, "
                       "sweep_tol, sweep_cg, recovery_speed, restitution, bounce_speed, "
-                      "wall, export)",
+                      "coefficients, wall, export)",
                       &key);
     i += used;
   }
@@ -248,6 +255,7 @@ std::string describe(const Settings &s)
   const double vb = s.model.bounce_speed;
   out += ", restitution " + format_g(s.model.restitution) + ", bounce_speed " +
          (vb < 0 ? "auto (" + format_g(s.model.bounce_steps) + " dt |f| / m max)" : format_g(vb));
+  out += std::string(", coefficients ") + to_string(s.model.coefficients);
   const FrictionParams &f = s.model.friction;
   return out + ", mu " + format_g(f.mu) + ", mu_roll " + format_g(f.mu_roll) + ", mu_twist " +
          format_g(f.mu_twist);

@@ -4,6 +4,8 @@
 
 #include <vector>
 
+#include "fibre/material.hpp"
+#include "fibre/names.hpp"
 #include "fibre/system.hpp"
 
 namespace fibre {
@@ -16,6 +18,18 @@ struct ComplianceParams {
   bool automatic = true;
   double eps_n = 0.0, eps_t = 0.0; // fixed mode
   double factor = 1e-2;            // automatic mode
+};
+
+// Where the friction and restitution coefficients come from: the pair style's coefficients
+// per type pair (`materials`, filled by the front end), or the model's own values for every
+// contact. Keywords the user typed override the pair style's values for every pair.
+enum class CoefficientSource { pair, fix };
+template <> struct EnumNames<CoefficientSource> {
+  static constexpr EnumName<CoefficientSource> table[] = {{CoefficientSource::pair, "pair"},
+                                                          {CoefficientSource::fix, "fix"}};
+};
+struct TypedCoefficients {
+  bool mu = false, mu_roll = false, mu_twist = false, restitution = false;
 };
 
 // The model of one simulation: rows per contact, SPOOK damping, compliance and friction.
@@ -40,6 +54,10 @@ struct ContactModel {
   double restitution = 0.0;
   double bounce_speed = -1.0;
   double bounce_steps = 2.0;
+  CoefficientSource coefficients = CoefficientSource::pair;
+  TypedCoefficients typed{};
+  MaterialTable materials; // empty: the pair style gave none (or coefficients fix)
+  bool per_type() const { return coefficients == CoefficientSource::pair && !materials.empty(); }
 };
 
 // The automatic bounce speed's scale: max over bodies of h |f| / m (local; a front end takes
@@ -57,7 +75,9 @@ double effective_radius(const std::vector<Body> &bodies, const Contact &c);
 double cone_coefficient(const FrictionParams &f, double r_eff, int cone);
 
 // Sets the per-row compliance, the friction coefficients and the restitution of every contact
-// (m_min: the lightest body of the simulation, read by automatic compliance only).
+// (m_min: the lightest body of the simulation, read by automatic compliance only). With
+// per-type coefficients a pair takes those of its bodies' types, a wall contact those of its
+// sphere's type with itself, and typed keywords override them.
 void apply_contact_model(const ContactModel &model, double h, double m_min,
                          const std::vector<Body> &bodies, std::vector<Contact> &contacts);
 

@@ -29,6 +29,7 @@ struct Body {
   Vec3 omega = Vec3::Zero();
   Vec3 force = Vec3::Zero();  // external force (gravity, other fixes), held over the step
   Vec3 torque = Vec3::Zero(); // external torque
+  int type = 0;               // the front end's atom type (1..ntypes), 0 when it has none
 };
 
 // The friction, rolling and twisting coefficients of one contact. A zero coefficient means no
@@ -54,6 +55,9 @@ struct Contact {
   // Newton's impact law on the normal row: a contact that closes within the step at a speed
   // above SpookParams::bounce_speed separates at restitution times that speed. 0: plastic.
   double restitution = 0.0;
+  // A wall contact's partner type for per-type coefficients: an obstacle atom's type, or 0
+  // for a wall (which takes the sphere's type).
+  int wall_type = 0;
   bool is_wall() const { return b < 0; }
 };
 

@@ -1,0 +1,61 @@
+// Contact coefficients per pair of atom types, as a front end reads them from its pair style
+// (LAMMPS's pair_coeff, LIGGGHTS's fix property/global): Coulomb, rolling and twisting
+// friction and the coefficient of restitution, with the mixing rule for pairs of different
+// types, and what one contact takes from them (doc/design.md section 2, "Material").
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "fibre/system.hpp"
+
+namespace fibre {
+
+// How the twisting limit follows from the pair style's twisting model:
+//   none      no twisting resistance;
+//   sds       |torque| <= mu_tw F_n with mu_tw a length (LAMMPS twisting sds);
+//   marshall  |torque| <= 2/3 a mu F_n with a = sqrt(r_eff overlap) the Hertz contact radius
+//             (Marshall 2009, LAMMPS twisting marshall): vanishes for rigid contacts.
+enum class TwistLaw { none, sds, marshall };
+
+struct PairCoefficients {
+  bool set = false;
+  double mu = 0.0;      // Coulomb
+  double mu_roll = 0.0; // rolling: |torque| <= mu_roll r_eff F_n
+  TwistLaw twist = TwistLaw::none;
+  double twist_coeff = 0.0; // sds: mu_tw (length)
+  // Newton's coefficient of restitution, or < 0 when the pair style's damping law has none
+  // (a viscous damping): the contact is then plastic unless the front end's keyword says more.
+  double restitution = -1.0;
+};
+
+// Symmetric table over types 1..ntypes.
+class MaterialTable {
+ public:
+  MaterialTable() = default;
+  explicit MaterialTable(int ntypes);
+  int ntypes() const { return ntypes_; }
+  bool empty() const { return ntypes_ == 0; }
+  PairCoefficients &at(int i, int j);
+  const PairCoefficients &at(int i, int j) const;
+  // Pairs i != j that were not set get the geometric mean of (i, i) and (j, j) for every
+  // coefficient (LAMMPS's rule for pair granular; the restitution through Tsuji's damping
+  // coefficient, which is what LAMMPS mixes). Returns "" or what cannot be mixed (a type
+  // without coefficients, or two twisting laws).
+  std::string mix();
+
+ private:
+  int ntypes_ = 0;
+  std::vector<PairCoefficients> pairs_;
+};
+
+// Tsuji's damping coefficient of a coefficient of restitution e in [0, 1] (the polynomial fit
+// that LAMMPS's `damping tsuji` applies to hertz/material's e), and its inverse on [0, 1].
+double tsuji_damping(double e);
+double restitution_from_tsuji(double alpha);
+
+// The friction of one contact (radius r_eff, overlap >= 0) from its pair's coefficients:
+// mu_twist per unit r_eff as FrictionParams keeps it.
+FrictionParams contact_friction(const PairCoefficients &p, double r_eff, double overlap);
+
+} // namespace fibre

@@ -1,0 +1,85 @@
+#include "fibre/material.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+namespace fibre {
+
+MaterialTable::MaterialTable(int ntypes)
+    : ntypes_(ntypes), pairs_(std::size_t(ntypes) * std::size_t(ntypes))
+{
+}
+
+PairCoefficients &MaterialTable::at(int i, int j)
+{
+  if (i > j) std::swap(i, j);
+  return pairs_[std::size_t(i - 1) * std::size_t(ntypes_) + std::size_t(j - 1)];
+}
+
+const PairCoefficients &MaterialTable::at(int i, int j) const
+{
+  if (i > j) std::swap(i, j);
+  return pairs_[std::size_t(i - 1) * std::size_t(ntypes_) + std::size_t(j - 1)];
+}
+
+std::string MaterialTable::mix()
+{
+  const auto geom = [](double a, double b) { return std::sqrt(a * b); };
+  for (int i = 1; i <= ntypes_; ++i)
+    for (int j = i + 1; j <= ntypes_; ++j) {
+      PairCoefficients &p = at(i, j);
+      if (p.set) continue;
+      const PairCoefficients &a = at(i, i), &b = at(j, j);
+      const std::string pair = std::to_string(i) + " " + std::to_string(j);
+      if (!a.set || !b.set)
+        return "types " + pair + ": no coefficients, and type " + std::to_string(a.set ? j : i) +
+               " has none with itself to mix from";
+      if (a.twist != b.twist) return "types " + pair + ": different twisting laws cannot mix";
+      p.set = true;
+      p.mu = geom(a.mu, b.mu);
+      p.mu_roll = geom(a.mu_roll, b.mu_roll);
+      p.twist = a.twist;
+      p.twist_coeff = geom(a.twist_coeff, b.twist_coeff);
+      p.restitution = a.restitution >= 0 && b.restitution >= 0
+                          ? restitution_from_tsuji(
+                                geom(tsuji_damping(a.restitution), tsuji_damping(b.restitution)))
+                          : -1.0;
+    }
+  return "";
+}
+
+double tsuji_damping(double e)
+{
+  static const double c[7] = {1.2728, -4.2783, 11.087, -22.348, 27.467, -18.022, 4.8218};
+  double v = 0.0;
+  for (int k = 6; k >= 0; --k) v = v * e + c[k];
+  return v;
+}
+
+double restitution_from_tsuji(double alpha)
+{
+  // the fit falls monotonically on [0, 1]: bisection
+  double lo = 0.0, hi = 1.0;
+  if (!(alpha < tsuji_damping(lo))) return 0.0;
+  if (!(alpha > tsuji_damping(hi))) return 1.0;
+  for (int k = 0; k < 60; ++k) {
+    const double mid = 0.5 * (lo + hi);
+    (tsuji_damping(mid) > alpha ? lo : hi) = mid;
+  }
+  return 0.5 * (lo + hi);
+}
+
+FrictionParams contact_friction(const PairCoefficients &p, double r_eff, double overlap)
+{
+  FrictionParams f;
+  f.mu = p.mu;
+  f.mu_roll = p.mu_roll;
+  f.mu_twist = 0.0;
+  if (p.twist == TwistLaw::sds && r_eff > 0)
+    f.mu_twist = p.twist_coeff / r_eff;
+  else if (p.twist == TwistLaw::marshall && r_eff > 0)
+    f.mu_twist = 2.0 / 3.0 * p.mu * std::sqrt(std::max(overlap, 0.0) / r_eff);
+  return f;
+}
+
+} // namespace fibre

@@ -1,0 +1,119 @@
+"""Coefficients per type pair from the pair style (keyword coefficients, default pair).
+
+- Two types on an incline (gravity tilted by theta, tan theta = 0.45) with pair_style granular:
+  type 1 has mu 0.2, type 2 mu 0.8, both rolling sds with mu_roll 1 (no rolling). The plane
+  wall takes each sphere's own type's coefficients. Type 1 slides with a = g (sin theta -
+  0.2 cos theta), type 2 sticks; on one process and on two.
+- The fix's typed mu overrides every pair: with mu 0.9 both stick.
+- Restitution per type from hertz/material's e with damping tsuji: a type-1 sphere (e 0.3)
+  and a type-2 sphere (e 0.9) dropped side by side rebound to e^2 h each, within 2%.
+- The older styles: gran/hooke/history's xmu is every pair's mu (a sphere slides with
+  xmu 0.2), and the log says which coefficients were read and what is not used.
+- coefficients fix: the pair style is ignored and the fix's defaults hold (mu 0.5: sticks).
+"""
+
+import math
+
+import fibre_e2e as e2e
+
+G = 1.0
+TAN = 0.45
+SIN, COS = TAN / math.sqrt(1 + TAN * TAN), 1 / math.sqrt(1 + TAN * TAN)
+DT = 1e-3
+T = 2.0
+
+GRANULAR = """pair_style granular
+pair_coeff 1 1 hertz/material 1e6 0.3 0.3 tangential mindlin NULL 1.0 0.2 rolling sds 1e3 50 1.0 damping tsuji
+pair_coeff 2 2 hertz/material 1e6 0.9 0.3 tangential mindlin NULL 1.0 0.8 rolling sds 1e3 50 1.0 damping tsuji"""
+
+
+def deck(pair, gravity, atoms, fix_extra, np, steps):
+    lines = ["atom_style sphere", "atom_modify map array", "boundary f f f", "newton off",
+             "comm_modify vel yes"]
+    if np == 2:
+        lines.append("processors 2 1 1")
+    lines += ["region box block -10 10 -10 10 0 10 units box", "create_box 2 box"]
+    for k, (t, x, z) in enumerate(atoms):
+        lines += ["create_atoms %d single %g 0 %g units box" % (t, x, z),
+                  "set atom %d diameter 1.0 density 1.0" % (k + 1)]
+    lines += pair.splitlines() + [
+        "neighbor 0.2 bin",
+        "timestep %g" % DT,
+        "fix g all gravity %g vector %s" % (G, gravity),
+        "fix fc all fibre_contact wall zplane 0.0 NULL %s" % fix_extra,
+        "variable vx1 equal vx[1]",
+        "variable vx2 equal vx[2]",
+        "variable z1 equal z[1]",
+        "variable z2 equal z[2]",
+        "variable vz1 equal vz[1]",
+        "variable vz2 equal vz[2]",
+        "thermo_style custom step v_vx1 v_vx2 v_z1 v_z2 v_vz1 v_vz2",
+        "thermo_modify format float %.17g",
+        "thermo 1",
+        "run %d" % steps,
+    ]
+    return "\n".join(lines) + "\n"
+
+
+def incline(args, ck, tag, pair, fix_extra, slides, np=1, types=(1, 2)):
+    gravity = "%.17g 0 %.17g" % (SIN, -COS)
+    atoms = [(types[0], -5.0, 0.5), (types[1], 5.0, 0.5)]
+    run = e2e.run_lmp(args, deck(pair, gravity, atoms, fix_extra, np, int(T / DT)), tag, np=np)
+    if not ck.ran(run, "%s: run completes" % tag):
+        return run
+    last = run.thermo[-1][-1]
+    for k, (slide, mu) in enumerate(slides):
+        v = last["v_vx%d" % (k + 1)]
+        if slide:
+            expected = G * (SIN - mu * COS) * T
+            ck.agree(v, expected, 1e-2, "%s: sphere %d slides with g (sin - %g cos)" %
+                     (tag, k + 1, mu))
+        else:
+            # at rest up to the solver's tolerance: 1e-4 of the free slide's speed
+            ck.check(abs(v) < 1e-4 * G * SIN * T, "%s: sphere %d sticks" % (tag, k + 1),
+                     "vx %.3g" % v)
+    return run
+
+
+def drop(args, ck):
+    h = 2.0
+    atoms = [(1, -3.0, h + 0.5), (2, 3.0, h + 0.5)]
+    tag = "drop_two_types"
+    run = e2e.run_lmp(args, deck(GRANULAR, "0 0 -1", atoms, "", 1, 4000), tag)
+    if not ck.ran(run, "%s: run completes" % tag):
+        return
+    rows = run.thermo[-1]
+    for k, e in ((1, 0.3), (2, 0.9)):
+        first = next(i for i in range(1, len(rows)) if rows[i]["v_vz%d" % k] > 0)
+        top = first
+        while top + 1 < len(rows) and rows[top + 1]["v_vz%d" % k] > 0:
+            top += 1
+        rebound = rows[top]["v_z%d" % k] - 0.5
+        ck.agree(rebound, e * e * h, 0.02,
+                 "%s: type %d (e %g from pair_coeff) rebounds to e^2 h" % (tag, k, e))
+
+
+def main():
+    args = e2e.parse_args()
+    ck = e2e.Checks("coefficients per type pair")
+    run = incline(args, ck, "incline_types", GRANULAR, "", [(True, 0.2), (False, 0.8)])
+    if run.rc == 0:
+        ck.check("1 1: mu 0.2, mu_roll 1, twisting none, restitution 0.3" in run.output and
+                 "2 2: mu 0.8, mu_roll 1, twisting none, restitution 0.9" in run.output,
+                 "incline_types: the log lists the coefficients read per type pair")
+    incline(args, ck, "incline_types_np2", GRANULAR, "", [(True, 0.2), (False, 0.8)], np=2)
+    incline(args, ck, "incline_typed_mu", GRANULAR, "mu 0.9", [(False, 0.9), (False, 0.9)])
+    drop(args, ck)
+    hooke = "pair_style gran/hooke/history 2000.0 NULL 50.0 NULL 0.2 0\npair_coeff * *"
+    run = incline(args, ck, "incline_gran_hooke", hooke, "mu_roll 1.0",
+                  [(True, 0.2), (True, 0.2)], types=(1, 1))
+    if run.rc == 0:
+        ck.check("mu = xmu 0.2" in run.output and "are not used" in run.output,
+                 "incline_gran_hooke: the log says xmu is used and the springs are not")
+    incline(args, ck, "incline_coefficients_fix", GRANULAR, "coefficients fix mu_roll 1.0",
+            [(False, 0.5), (False, 0.5)])
+    ck.close()
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,122 @@
+// Coefficients per type pair (fibre/material.hpp): Tsuji's damping fit against the value LAMMPS
+// stores for e = 0.3 and 0.6 (read from its restart record on this machine), its inverse, the
+// mixing rule, and what a contact takes from its pair; apply_contact_model with types, walls,
+// obstacles and typed keywords.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "fibre/contact_model.hpp"
+#include "fibre/material.hpp"
+
+using namespace fibre;
+
+TEST(Material, TsujiFitAndInverse)
+{
+  // pair_coeff ... hertz/material E e nu ... damping tsuji stores these (LAMMPS 29 Sep 2021)
+  EXPECT_NEAR(tsuji_damping(0.3), 0.565948, 1e-6);
+  EXPECT_NEAR(tsuji_damping(0.6), 0.25327, 1e-5);
+  for (double e : {0.0, 0.05, 0.3, 0.5, 0.9, 0.99})
+    EXPECT_NEAR(restitution_from_tsuji(tsuji_damping(e)), e, 1e-12) << e;
+  EXPECT_EQ(restitution_from_tsuji(5.0), 0.0);
+  EXPECT_EQ(restitution_from_tsuji(-1.0), 1.0);
+}
+
+TEST(Material, MixingIsGeometric)
+{
+  MaterialTable t(3);
+  PairCoefficients a, b;
+  a.set = b.set = true;
+  a.mu = 0.2;
+  b.mu = 0.8;
+  a.mu_roll = 0.1;
+  b.mu_roll = 0.4;
+  a.restitution = 0.3;
+  b.restitution = 0.9;
+  t.at(1, 1) = a;
+  t.at(2, 2) = b;
+  t.at(3, 3) = a;
+  PairCoefficients c = a;
+  c.mu = 0.7;
+  t.at(3, 1) = c; // set explicitly: kept (and the table is symmetric)
+  EXPECT_EQ(t.mix(), "");
+  EXPECT_DOUBLE_EQ(t.at(1, 2).mu, 0.4);
+  EXPECT_DOUBLE_EQ(t.at(2, 1).mu_roll, 0.2);
+  EXPECT_NEAR(t.at(1, 2).restitution,
+              restitution_from_tsuji(std::sqrt(tsuji_damping(0.3) * tsuji_damping(0.9))), 1e-12);
+  EXPECT_GT(t.at(1, 2).restitution, 0.3);
+  EXPECT_LT(t.at(1, 2).restitution, 0.9);
+  EXPECT_DOUBLE_EQ(t.at(1, 3).mu, 0.7);
+  // a type without its own coefficients, and two twisting laws, cannot mix
+  MaterialTable u(2);
+  u.at(1, 1) = a;
+  EXPECT_NE(u.mix().find("type 2 has none"), std::string::npos);
+  MaterialTable v(2);
+  v.at(1, 1) = a;
+  b.twist = TwistLaw::sds;
+  v.at(2, 2) = b;
+  EXPECT_NE(v.mix().find("different twisting laws"), std::string::npos);
+}
+
+TEST(Material, ContactFrictionFromTwistingLaws)
+{
+  PairCoefficients p;
+  p.mu = 0.6;
+  p.mu_roll = 0.1;
+  p.twist = TwistLaw::sds;
+  p.twist_coeff = 0.02; // a length: limit 0.02 F_n
+  FrictionParams f = contact_friction(p, 0.5, 0.0);
+  EXPECT_DOUBLE_EQ(f.mu, 0.6);
+  EXPECT_DOUBLE_EQ(f.mu_roll, 0.1);
+  EXPECT_DOUBLE_EQ(cone_coefficient(f, 0.5, 1), 0.02); // the twisting cone's radius per F_n
+  p.twist = TwistLaw::marshall;                         // 2/3 a mu, a = sqrt(r_eff overlap)
+  f = contact_friction(p, 0.5, 0.02);
+  EXPECT_NEAR(cone_coefficient(f, 0.5, 1), 2.0 / 3.0 * std::sqrt(0.5 * 0.02) * 0.6, 1e-15);
+  EXPECT_EQ(contact_friction(p, 0.5, 0.0).mu_twist, 0.0); // rigid: no contact area
+}
+
+TEST(Material, ApplyContactModelPerType)
+{
+  std::vector<Body> bodies(3);
+  for (int i = 0; i < 3; ++i) {
+    bodies[i].x = Vec3(3.0 * i, 0, 0);
+    bodies[i].type = i == 2 ? 2 : 1;
+  }
+  std::vector<Contact> contacts(4);
+  contacts[0].a = 0; // pair 1 1
+  contacts[0].b = 1;
+  contacts[1].a = 1; // pair 1 2
+  contacts[1].b = 2;
+  contacts[2].a = 2; // wall: 2 2
+  contacts[3].a = 0; // obstacle of type 2: 1 2
+  contacts[3].wall_type = 2;
+  ContactModel model;
+  model.materials = MaterialTable(2);
+  PairCoefficients a, b;
+  a.set = b.set = true;
+  a.mu = 0.2;
+  b.mu = 0.8;
+  a.restitution = 0.3;
+  b.restitution = -1.0; // viscous: no coefficient of restitution
+  model.materials.at(1, 1) = a;
+  model.materials.at(2, 2) = b;
+  ASSERT_EQ(model.materials.mix(), "");
+  apply_contact_model(model, 1e-3, 1.0, bodies, contacts);
+  EXPECT_DOUBLE_EQ(contacts[0].friction.mu, 0.2);
+  EXPECT_DOUBLE_EQ(contacts[1].friction.mu, 0.4);
+  EXPECT_DOUBLE_EQ(contacts[2].friction.mu, 0.8);
+  EXPECT_DOUBLE_EQ(contacts[3].friction.mu, 0.4);
+  EXPECT_DOUBLE_EQ(contacts[0].restitution, 0.3);
+  EXPECT_DOUBLE_EQ(contacts[2].restitution, 0.0); // plastic: the model's default
+  EXPECT_DOUBLE_EQ(contacts[1].restitution, 0.0); // mixing with "none" gives none
+  // typed keywords override every pair; coefficients fix ignores the table
+  model.typed.mu = true;
+  model.friction.mu = 0.9;
+  apply_contact_model(model, 1e-3, 1.0, bodies, contacts);
+  for (const Contact &c : contacts) EXPECT_DOUBLE_EQ(c.friction.mu, 0.9);
+  model.typed = TypedCoefficients{};
+  model.coefficients = CoefficientSource::fix;
+  model.friction.mu = 0.5;
+  apply_contact_model(model, 1e-3, 1.0, bodies, contacts);
+  for (const Contact &c : contacts) EXPECT_DOUBLE_EQ(c.friction.mu, 0.5);
+}
