@@ -424,8 +424,8 @@ void FixFibreContact::final_integrate()
   // build (a step without contacts anywhere is free flight: an empty system and result)
   std::vector<fibre::Contact> contacts;
   for (const fibre::DetectedContact &fc : found) contacts.push_back(fc.contact);
-  if (any) fibre::apply_contact_model(model, dtv_, m_min_, bodies, contacts);
   const fibre::Vector warm = history_.warm_start(found, model.rows, dtv_);
+  if (any) fibre::apply_contact_model(model, dtv_, m_min_, bodies, contacts, &warm);
   fibre::ContactSystem sys(std::move(bodies), std::move(contacts), model.rows, params,
                            exchange_->num_owned());
 

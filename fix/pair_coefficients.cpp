@@ -64,7 +64,7 @@ void read_granular(const std::string &bytes, int ntypes, PairReading &out)
 {
   Record rec(bytes);
   fibre::MaterialTable table(ntypes);
-  bool cohesion = false, springs = false;
+  bool cohesion = false;
   for (int i = 1; i <= ntypes; ++i)
     for (int j = i; j <= ntypes; ++j) {
       if (!rec.next_int()) continue; // setflag: mixed at init
@@ -91,8 +91,20 @@ void read_granular(const std::string &bytes, int ntypes, PairReading &out)
                                 : fibre::TwistLaw::none;
       p.twist_coeff = model[4] == 1 ? twist[2] : 0.0;
       p.restitution = model[1] == kTsuji ? fibre::restitution_from_tsuji(normal[1]) : -1.0;
+      // elastic laws (compliance material); dmt's elastic part is hertz/material's, jkr's
+      // stored constants are not the Hertz ones
+      const fibre::NormalLaw laws[5] = {fibre::NormalLaw::hooke, fibre::NormalLaw::hertz,
+                                        fibre::NormalLaw::hertz_material,
+                                        fibre::NormalLaw::hertz_material, fibre::NormalLaw::none};
+      p.normal = laws[model[0]];
+      p.k_n = normal[0];
+      p.tangential = model[2] == 0   ? fibre::TangentialLaw::none
+                     : model[2] == 1 ? fibre::TangentialLaw::linear
+                                     : fibre::TangentialLaw::mindlin;
+      p.k_t = tangential[0];
+      p.k_roll = model[3] == 1 ? roll[0] : 0.0;
+      p.k_twist = model[4] == 1 ? twist[0] : 0.0;
       cohesion = cohesion || model[0] == kDmt || model[0] == kJkr;
-      springs = springs || model[3] == 1 || model[4] == 1;
       if (model[1] != kTsuji)
         out.notes.push_back("types " + std::to_string(i) + " " + std::to_string(j) + ": damping " +
                             kDamping[model[1]] +
@@ -108,11 +120,9 @@ void read_granular(const std::string &bytes, int ntypes, PairReading &out)
     out.failure = mixed;
     return;
   }
-  out.notes.push_back("the normal and tangential stiffness and damping of pair_coeff are not "
-                      "used: the contact rows are rigid up to the fix's compliance");
-  if (springs)
-    out.notes.push_back("rolling and twisting sds: k and gamma are not used, the rows are "
-                        "rigid-plastic up to their friction limit");
+  out.notes.push_back("the stiffnesses of pair_coeff (normal, tangential, rolling and twisting "
+                      "sds) set the rows' compliance with 'compliance material' only; the "
+                      "damping coefficients are not used (SPOOK's damping, and e for bounces)");
   if (cohesion) out.notes.push_back("the cohesion of dmt and jkr is not modelled");
   out.table = std::move(table);
 }
@@ -121,6 +131,7 @@ void read_granular(const std::string &bytes, int ntypes, PairReading &out)
 // dampflag (int), then setflag per type pair.
 void read_gran(const std::string &style, const std::string &bytes, int ntypes, PairReading &out)
 {
+  const bool hertz = style == "gran/hertz/history", history = style != "gran/hooke";
   Record rec(bytes);
   const double kn = rec.next_double(), kt = rec.next_double(), gamman = rec.next_double();
   rec.next_double(); // gammat
@@ -137,10 +148,18 @@ void read_gran(const std::string &style, const std::string &bytes, int ntypes, P
       fibre::PairCoefficients &p = table.at(i, j);
       p.set = true;
       p.mu = xmu;
+      p.normal = hertz ? fibre::NormalLaw::hertz : fibre::NormalLaw::hooke;
+      p.k_n = kn;
+      // the tangential spring (history styles) is scaled like the normal one
+      p.tangential = !history ? fibre::TangentialLaw::none
+                     : hertz  ? fibre::TangentialLaw::mindlin
+                              : fibre::TangentialLaw::linear;
+      p.k_t = kt;
     }
   out.notes.push_back("pair style " + style + ": mu = xmu " + fibre::format_g(xmu) + "; kn " +
                       fibre::format_g(kn) + ", kt " + fibre::format_g(kt) +
-                      " are not used (rigid rows), and its damping gamman " +
+                      " are used by 'compliance material' only (else rigid rows), and its "
+                      "damping gamman " +
                       fibre::format_g(gamman) +
                       " is viscous, without a single coefficient of restitution: the contacts "
                       "are plastic unless the fix's restitution keyword is given");

@@ -73,10 +73,14 @@ Vector assemble_rhs(const ContactSystem &sys)
     f.segment<3>(6 * i + 3) = b.torque;
   }
   const SparseMatrix G = assemble_G(sys);
-  Vector rhs = -(1.0 - ups) * (G * v) - p.h * (G * sys.inv_mass().cwiseProduct(f));
+  const Vector Gv = G * v;
+  Vector rhs = -(1.0 - ups) * Gv - p.h * (G * sys.inv_mass().cwiseProduct(f));
   for (int c = 0; c < sys.num_contacts(); ++c) {
+    const Contact &k = sys.contacts()[c];
     const Eigen::Index row = Eigen::Index(sys.rows()) * c;
-    if (sys.row_active(row)) rhs[row] += p.gap_term(sys.contacts()[c].gap);
+    const double ups_c = p.upsilon(p.damping_of(k));
+    for (int r = 0; r < sys.rows(); ++r) rhs[row + r] += (ups_c - ups) * Gv[row + r];
+    if (sys.row_active(row)) rhs[row] += p.gap_term(k.gap, ups_c);
   }
   return rhs;
 }

@@ -18,12 +18,15 @@ double cone_coefficient(const FrictionParams &f, double r_eff, int cone)
 }
 
 void apply_contact_model(const ContactModel &model, double h, double m_min,
-                         const std::vector<Body> &bodies, std::vector<Contact> &contacts)
+                         const std::vector<Body> &bodies, std::vector<Contact> &contacts,
+                         const Vector *last)
 {
   const ComplianceParams &p = model.compliance;
   double eps_n = p.eps_n, eps_t = p.eps_t;
-  if (p.automatic) eps_n = eps_t = p.factor * h * h / m_min;
-  for (Contact &c : contacts) {
+  if (p.automatic || p.material) eps_n = eps_t = p.factor * h * h / m_min;
+  const int rows = model.rows;
+  for (std::size_t k = 0; k < contacts.size(); ++k) {
+    Contact &c = contacts[k];
     const double reff = effective_radius(bodies, c);
     c.compliance[0] = eps_n;
     c.compliance[1] = c.compliance[2] = eps_t;
@@ -35,13 +38,26 @@ void apply_contact_model(const ContactModel &model, double h, double m_min,
     const int tb = !c.is_wall() ? bodies[c.b].type : c.wall_type > 0 ? c.wall_type : ta;
     if (ta < 1 || tb < 1 || ta > model.materials.ntypes() || tb > model.materials.ntypes())
       continue; // no type: the model's values
-    const PairCoefficients &p = model.materials.at(ta, tb);
-    const FrictionParams f = contact_friction(p, reff, std::max(-c.gap, 0.0));
+    const PairCoefficients &pc = model.materials.at(ta, tb);
+    const double overlap = std::max(-c.gap, 0.0);
+    const FrictionParams f = contact_friction(pc, reff, overlap);
     const TypedCoefficients &typed = model.typed;
     if (!typed.mu) c.friction.mu = f.mu;
     if (!typed.mu_roll) c.friction.mu_roll = f.mu_roll;
     if (!typed.mu_twist) c.friction.mu_twist = f.mu_twist;
-    if (!typed.restitution && p.restitution >= 0) c.restitution = p.restitution;
+    if (!typed.restitution && pc.restitution >= 0) c.restitution = pc.restitution;
+    if (p.material) {
+      const bool has_last = last && last->size() >= Eigen::Index(rows) * Eigen::Index(k + 1);
+      const double force = has_last ? std::max((*last)[Eigen::Index(rows) * k], 0.0) / h : 0.0;
+      const std::array<double, kMaxRows> rigid = c.compliance;
+      material_compliance(pc, reff, overlap, force, rigid, c.compliance);
+      // Soft contacts get at least critical damping, tau = 2 sqrt(m_eff eps) (SPOOK's d = 2
+      // would leave a Hertz column ringing): at rest they sit still, bounces come from e.
+      const double ma = bodies[c.a].mass;
+      const double m_eff = c.is_wall() ? ma : ma * bodies[c.b].mass / (ma + bodies[c.b].mass);
+      const double critical = 2.0 * std::sqrt(m_eff * c.compliance[0]) / h;
+      if (critical > model.damping) c.damping = critical;
+    }
   }
 }
 

@@ -40,6 +40,20 @@ std::string MaterialTable::mix()
       p.mu_roll = geom(a.mu_roll, b.mu_roll);
       p.twist = a.twist;
       p.twist_coeff = geom(a.twist_coeff, b.twist_coeff);
+      // hertz/material stores 4/3 E_eff and 8 G_eff of the like pair; LAMMPS's E/nu mixing of
+      // unlike materials is their harmonic mean. Other stiffnesses mix geometrically.
+      const bool material = a.normal == NormalLaw::hertz_material;
+      const auto stiff = [&](double x, double y) {
+        return material ? (x > 0 && y > 0 ? 2.0 / (1.0 / x + 1.0 / y) : 0.0) : geom(x, y);
+      };
+      if (a.normal != b.normal || a.tangential != b.tangential)
+        return "types " + pair + ": different normal or tangential laws cannot mix";
+      p.normal = a.normal;
+      p.tangential = a.tangential;
+      p.k_n = stiff(a.k_n, b.k_n);
+      p.k_t = stiff(a.k_t, b.k_t);
+      p.k_roll = geom(a.k_roll, b.k_roll);
+      p.k_twist = geom(a.k_twist, b.k_twist);
       p.restitution = a.restitution >= 0 && b.restitution >= 0
                           ? restitution_from_tsuji(
                                 geom(tsuji_damping(a.restitution), tsuji_damping(b.restitution)))
@@ -80,6 +94,23 @@ FrictionParams contact_friction(const PairCoefficients &p, double r_eff, double 
   else if (p.twist == TwistLaw::marshall && r_eff > 0)
     f.mu_twist = 2.0 / 3.0 * p.mu * std::sqrt(std::max(overlap, 0.0) / r_eff);
   return f;
+}
+
+bool material_compliance(const PairCoefficients &p, double r_eff, double overlap, double last_force,
+                         const std::array<double, kMaxRows> &rigid,
+                         std::array<double, kMaxRows> &eps)
+{
+  eps = rigid;
+  if (p.normal == NormalLaw::none || !(p.k_n > 0) || !(r_eff > 0)) return false;
+  const bool hertz = p.normal != NormalLaw::hooke;
+  const double d_now = std::max(overlap, 0.0);
+  const double f_now = hertz ? p.k_n * std::sqrt(r_eff * d_now) * d_now : p.k_n * d_now;
+  const double f = std::max(last_force, f_now);
+  if (!(f > 0)) return true; // unloaded: rigid until it carries load
+  // the law's overlap at the reference load, and its contact radius
+  const double d = hertz ? std::cbrt(f * f / (p.k_n * p.k_n * r_eff)) : f / p.k_n;
+  eps[0] = d / f;
+  return true;
 }
 
 } // namespace fibre

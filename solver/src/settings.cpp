@@ -128,15 +128,18 @@ std::size_t read_model_keyword(const Reader &in, std::size_t i, Settings &s)
 {
   const std::string &key = in.at(i);
   if (key == "compliance") {
-    const std::string e = "'compliance auto' or 'compliance <eps_n> <eps_t>' (positive numbers)";
+    const std::string e =
+        "'compliance auto|material' or 'compliance <eps_n> <eps_t>' (positive numbers)";
     if (!in.has(i + 1)) Reader::illegal(e);
-    if (in.at(i + 1) == "auto") {
+    if (in.at(i + 1) == "auto" || in.at(i + 1) == "material") {
       s.model.compliance.automatic = true;
+      s.model.compliance.material = in.at(i + 1) == "material";
       return 2;
     }
     const double en = in.positive(i + 1, e);
     const double et = in.positive(i + 2, e);
     s.model.compliance.automatic = false;
+    s.model.compliance.material = false;
     s.model.compliance.eps_n = en;
     s.model.compliance.eps_t = et;
     return 3;
@@ -244,7 +247,9 @@ std::string describe(const Settings &s)
   const ComplianceParams &c = s.model.compliance;
   std::string out = describe(s.step) + ", rows " + std::to_string(s.model.rows) + ", damping " +
                     format_g(s.model.damping) + ", compliance ";
-  if (c.automatic)
+  if (c.material)
+    out += "material (pair style, else " + format_g(c.factor) + " dt^2 / m_min)";
+  else if (c.automatic)
     out += "auto (" + format_g(c.factor) + " dt^2 / m_min)";
   else
     out += format_g(c.eps_n) + " " + format_g(c.eps_t);

@@ -36,17 +36,22 @@ Vector spook_rhs(const ContactSystem &sys, const Vector *extra_dv)
   Vector b;
   g_apply(sys, w, b);
   b = -b;
-  Vector Gv; // the normal approach speeds, where a contact can bounce
+  // G v, where a contact bounces or has its own damping
+  Vector Gv;
   for (const Contact &k : sys.contacts())
-    if (k.restitution > 0) {
+    if (k.restitution > 0 || k.damping >= 0) {
       g_apply(sys, body_velocities(sys), Gv);
       break;
     }
+  const int rows = sys.rows();
   for (int c = 0; c < sys.num_contacts(); ++c) {
-    const Eigen::Index row = Eigen::Index(sys.rows()) * c; // normal row
-    if (!sys.row_active(row)) continue;
     const Contact &k = sys.contacts()[c];
-    const double b_spook = b[row] + p.gap_term(k.gap);
+    const Eigen::Index row = Eigen::Index(rows) * c; // normal row
+    const double ups_c = p.upsilon(p.damping_of(k));
+    if (k.damping >= 0) // -(1 - Upsilon_c) G v on every row of the contact
+      for (int r = 0; r < rows; ++r) b[row + r] += (ups_c - ups) * Gv[row + r];
+    if (!sys.row_active(row)) continue;
+    const double b_spook = b[row] + p.gap_term(k.gap, ups_c);
     // Row: G_n v+ + eps lambda_n = G_n (v + h M^-1 f) + b_n, so b_n = 0 is free flight and
     // Newton's law G_n v+ = -e vn (vn = G_n v) is b_n = b_n(no gap) - (Upsilon + e) vn.
     // A contact that bounces keeps its approach speed until the step in which it closes:
@@ -56,14 +61,15 @@ Vector spook_rhs(const ContactSystem &sys, const Vector *extra_dv)
     if (bounces && k.gap + p.h * vn <= 0) {
       // The compliance would keep Sigma / (w + Sigma) of the jump, w = 1/m_a + 1/m_b the
       // row's G M^-1 G^T: ask for that much more (exact for an isolated contact).
-      const double w =
+      const double w_nn =
           1.0 / sys.bodies()[k.a].mass + (k.is_wall() ? 0.0 : 1.0 / sys.bodies()[k.b].mass);
-      const double jump = (b[row] - (ups + k.restitution) * vn) * (1.0 + sys.sigma()[row] / w);
+      const double jump = (b[row] - (ups_c + k.restitution) * vn) * (1.0 + sys.sigma()[row] / w_nn);
       b[row] = std::max(b_spook, jump);
-    } else if (bounces && k.gap > 0)
+    } else if (bounces && k.gap > 0) {
       b[row] = std::min(b_spook, 0.0);
-    else
+    } else {
       b[row] = b_spook;
+    }
   }
   return b;
 }

@@ -92,9 +92,10 @@ void ContactSystem::compute_derived()
     q.frame.row(2) = k.t2.transpose();
     q.ra = k.point - bodies_[k.a].x;
     q.rb = k.is_wall() ? Vec3::Zero() : Vec3(k.point - bodies_[k.b].x);
+    const double d = params_.damping_of(k);
     for (int r = 0; r < rows_; ++r) {
       const Eigen::Index row = Eigen::Index(rows_) * c + r;
-      sigma_[row] = row_active(row) ? params_.sigma(k.compliance[r]) : 1.0;
+      sigma_[row] = row_active(row) ? params_.sigma(k.compliance[r], d) : 1.0;
     }
   }
   inv_sigma_ = sigma_.cwiseInverse();

@@ -19,7 +19,7 @@ constexpr const char *kMagic = "fibre_contact_system";
 constexpr int kBodyFields = 17;
 constexpr int kContactFieldsV1 = 2 + 12 + 1 + kMaxRows;
 constexpr int kContactFieldsV2 = kContactFieldsV1 + 3; // + mu, mu_roll, mu_twist
-constexpr int kContactFields = kContactFieldsV2 + 1;   // version 3: + restitution
+constexpr int kContactFields = kContactFieldsV2 + 2;   // version 3: + restitution, damping
 // Unit vectors must read back as unit vectors; exported data are far more exact than this.
 constexpr double kUnitTol = 1e-6;
 
@@ -222,7 +222,8 @@ void write_system(std::ostream &out, const ContactSystem &sys)
       s += ' ';
       put_real(s, eps);
     }
-    for (double f : {c.friction.mu, c.friction.mu_roll, c.friction.mu_twist, c.restitution}) {
+    for (double f :
+         {c.friction.mu, c.friction.mu_roll, c.friction.mu_twist, c.restitution, c.damping}) {
       s += ' ';
       put_real(s, f);
     }
@@ -360,6 +361,9 @@ ContactSystem parse_system(std::string_view text)
     k.restitution = in.real(t[kContactFieldsV2], what + " restitution");
     if (!(k.restitution >= 0 && k.restitution <= 1))
       in.fail(what + ": restitution must be in [0, 1]");
+    k.damping = in.real(t[kContactFieldsV2 + 1], what + " damping");
+    if (!(k.damping >= 0 || k.damping == -1))
+      in.fail(what + ": damping must be non-negative, or -1 for the system's");
   }
 
   const long long dofs = rows * nc;

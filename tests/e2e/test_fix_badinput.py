@@ -62,8 +62,8 @@ CASES = [
     ("sweep_tol_missing", "sweep_tol", "expected 'sweep_tol <positive number>'", {}),
     ("maxiter_zero", "maxiter 0", "expected 'maxiter <positive integer>', got '0'", {}),
     ("maxiter_real", "maxiter 2.5", "expected 'maxiter <positive integer>', got '2.5'", {}),
-    ("compliance_one", "compliance 1e-6", "expected 'compliance auto' or 'compliance <eps_n> "
-     "<eps_t>'", {}),
+    ("compliance_one", "compliance 1e-6",
+     "expected 'compliance auto|material' or 'compliance <eps_n> <eps_t>'", {}),
     ("compliance_negative", "compliance -1 1e-6", "'compliance <eps_n> <eps_t>' (positive "
      "numbers), got '-1'", {}),
     ("damping_zero", "damping 0", "expected 'damping <positive number of steps>', got '0'", {}),

@@ -10,6 +10,9 @@
 - The older styles: gran/hooke/history's xmu is every pair's mu (a sphere slides with
   xmu 0.2), and the log says which coefficients were read and what is not used.
 - coefficients fix: the pair style is ignored and the fix's defaults hold (mu 0.5: sticks).
+- compliance material: a resting column of spheres of hertz/material overlaps as Hertz says,
+  d = (W / (k_n sqrt(r_eff)))^(2/3) with W the weight above each contact and k_n = 4/3 E_eff:
+  every sphere's height within 1% of the overlaps below it, serial and on two processes.
 """
 
 import math
@@ -93,6 +96,33 @@ def drop(args, ck):
                  "%s: type %d (e %g from pair_coeff) rebounds to e^2 h" % (tag, k, e))
 
 
+def hertz_column(args, ck, np):
+    E, nu, n = 2e4, 0.3, 5
+    k_n = 4.0 / 3.0 * E / (2 * (1 - nu * nu))
+    atoms = [(1, 0.0, 0.5 + k) for k in range(n)]
+    pair = ("pair_style granular\npair_coeff * * hertz/material %g 0.5 %g tangential mindlin "
+            "NULL 1.0 0.5 damping tsuji" % (E, nu))
+    lines = deck(pair, "0 0 -1", atoms, "compliance material", np, 3000).splitlines()
+    lines = [ln.replace("thermo 1", "thermo 100") for ln in lines]
+    lines.insert(-1, "dump a all custom 3000 hertz_np%d.atoms id z mass" % np)
+    lines.insert(-1, "dump_modify a sort id format float %.17g")
+    tag = "hertz_column_np%d" % np
+    run = e2e.run_lmp(args, "\n".join(lines) + "\n", tag, np=np)
+    if not ck.ran(run, "%s: run completes" % tag):
+        return
+    atoms = e2e.dump_by_id(e2e.parse_dump(args.workdir + "/hertz_np%d.atoms" % np)[-1])
+    ids = sorted(atoms)
+    z_expected, worst = 0.0, 0.0
+    for k, i in enumerate(ids):
+        weight = G * sum(atoms[j]["mass"] for j in ids[k:])
+        r_eff = 0.5 if k == 0 else 0.25  # the floor, then a pair of equal spheres
+        overlap = (weight / (k_n * r_eff ** 0.5)) ** (2.0 / 3.0)
+        z_expected += (0.5 if k == 0 else 1.0) - overlap
+        worst = max(worst, abs(atoms[i]["z"] - z_expected) / overlap)
+    ck.check(worst < 0.01, "%s: Hertz overlaps at rest (largest error per overlap)" % tag,
+             "%.3g of an overlap" % worst)
+
+
 def main():
     args = e2e.parse_args()
     ck = e2e.Checks("coefficients per type pair")
@@ -108,10 +138,13 @@ def main():
     run = incline(args, ck, "incline_gran_hooke", hooke, "mu_roll 1.0",
                   [(True, 0.2), (True, 0.2)], types=(1, 1))
     if run.rc == 0:
-        ck.check("mu = xmu 0.2" in run.output and "are not used" in run.output,
+        ck.check("mu = xmu 0.2" in run.output and
+                 "used by 'compliance material' only" in run.output,
                  "incline_gran_hooke: the log says xmu is used and the springs are not")
     incline(args, ck, "incline_coefficients_fix", GRANULAR, "coefficients fix mu_roll 1.0",
             [(False, 0.5), (False, 0.5)])
+    for np in (1, 2):
+        hertz_column(args, ck, np)
     ck.close()
 
 

@@ -69,7 +69,7 @@ TEST(Material, ContactFrictionFromTwistingLaws)
   EXPECT_DOUBLE_EQ(f.mu, 0.6);
   EXPECT_DOUBLE_EQ(f.mu_roll, 0.1);
   EXPECT_DOUBLE_EQ(cone_coefficient(f, 0.5, 1), 0.02); // the twisting cone's radius per F_n
-  p.twist = TwistLaw::marshall;                         // 2/3 a mu, a = sqrt(r_eff overlap)
+  p.twist = TwistLaw::marshall;                        // 2/3 a mu, a = sqrt(r_eff overlap)
   f = contact_friction(p, 0.5, 0.02);
   EXPECT_NEAR(cone_coefficient(f, 0.5, 1), 2.0 / 3.0 * std::sqrt(0.5 * 0.02) * 0.6, 1e-15);
   EXPECT_EQ(contact_friction(p, 0.5, 0.0).mu_twist, 0.0); // rigid: no contact area
@@ -119,4 +119,51 @@ TEST(Material, ApplyContactModelPerType)
   model.friction.mu = 0.5;
   apply_contact_model(model, 1e-3, 1.0, bodies, contacts);
   for (const Contact &c : contacts) EXPECT_DOUBLE_EQ(c.friction.mu, 0.5);
+}
+
+// compliance material: the secant compliance at the reference load gives the law's overlap.
+TEST(Material, SecantComplianceOfTheNormalLaw)
+{
+  PairCoefficients p;
+  p.set = true;
+  p.normal = NormalLaw::hertz_material;
+  p.k_n = 7.3e4; // 4/3 E_eff
+  const double r_eff = 0.25, load = 3.0;
+  const std::array<double, kMaxRows> rigid = {1e-9, 2e-9, 2e-9, 3e-9, 4e-9, 4e-9};
+  std::array<double, kMaxRows> eps{};
+  // loaded by the last step: eps F is Hertz's overlap at F, whatever the overlap now
+  ASSERT_TRUE(material_compliance(p, r_eff, 0.0, load, rigid, eps));
+  const double hertz = std::pow(load / (p.k_n * std::sqrt(r_eff)), 2.0 / 3.0);
+  EXPECT_NEAR(eps[0] * load, hertz, 1e-14);
+  for (int r = 1; r < kMaxRows; ++r) EXPECT_EQ(eps[r], rigid[r]); // no displacement history
+  // a native state: no last force, the overlap's own Hertz force is the reference
+  ASSERT_TRUE(material_compliance(p, r_eff, hertz, 0.0, rigid, eps));
+  EXPECT_NEAR(eps[0] * load, hertz, 1e-12);
+  // unloaded and not overlapping: rigid; Hooke: 1/k_n at any load; no law: rigid
+  material_compliance(p, r_eff, 0.0, 0.0, rigid, eps);
+  EXPECT_EQ(eps[0], rigid[0]);
+  p.normal = NormalLaw::hooke;
+  material_compliance(p, r_eff, 0.0, load, rigid, eps);
+  EXPECT_DOUBLE_EQ(eps[0], 1.0 / p.k_n);
+  p.normal = NormalLaw::none;
+  EXPECT_FALSE(material_compliance(p, r_eff, 0.0, load, rigid, eps));
+  EXPECT_EQ(eps[0], rigid[0]);
+}
+
+// Unlike hertz/material types mix by the harmonic mean of the stored 4/3 E_eff (LAMMPS mixes E
+// and nu: 1 / E_eff = (1 - nu_i^2) / E_i + (1 - nu_j^2) / E_j).
+TEST(Material, HertzMaterialStiffnessMixesLikeEAndNu)
+{
+  const auto k = [](double E, double nu) { return 4.0 / 3.0 * E / (2.0 * (1.0 - nu * nu)); };
+  MaterialTable t(2);
+  PairCoefficients a, b;
+  a.set = b.set = true;
+  a.normal = b.normal = NormalLaw::hertz_material;
+  a.k_n = k(1e5, 0.3);
+  b.k_n = k(4e5, 0.2);
+  t.at(1, 1) = a;
+  t.at(2, 2) = b;
+  ASSERT_EQ(t.mix(), "");
+  const double e_eff = 1.0 / ((1 - 0.09) / 1e5 + (1 - 0.04) / 4e5);
+  EXPECT_NEAR(t.at(1, 2).k_n, 4.0 / 3.0 * e_eff, 1e-9 * e_eff);
 }

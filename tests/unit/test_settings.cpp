@@ -148,7 +148,8 @@ TEST(Settings, BadInputNamesTheKeywordAndItsForm)
   EXPECT_EQ(parse_settings(words("restitution 0.5 bounce_speed 0.2")).model.restitution, 0.5);
   EXPECT_EQ(parse_settings(words("restitution 0.5 bounce_speed 0.2")).model.bounce_speed, 0.2);
   EXPECT_EQ(error_of("compliance 1e-6"),
-            "expected 'compliance auto' or 'compliance <eps_n> <eps_t>' (positive numbers)");
+            "expected 'compliance auto|material' or 'compliance <eps_n> <eps_t>' (positive "
+            "numbers)");
   EXPECT_EQ(error_of("wall zplane NULL NULL"),
             "expected 'wall zplane <lo|NULL> <hi|NULL>' with at least one of lo and hi a number");
   EXPECT_EQ(error_of("wall zplane 2 1"),

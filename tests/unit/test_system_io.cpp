@@ -191,29 +191,38 @@ std::string older_version(const ContactSystem &sys, int version, int drop_spook,
 TEST(SystemIo, OlderVersionsAndCoefficientFields)
 {
   const ContactSystem sys = sample_system();
-  const ContactSystem v1 = parse_system(older_version(sys, 1, 2, 4));
+  const ContactSystem v1 = parse_system(older_version(sys, 1, 2, 5));
   ASSERT_EQ(v1.num_contacts(), sys.num_contacts());
   EXPECT_EQ(v1.contacts()[1].friction.mu, FrictionParams{}.mu);
   EXPECT_EQ(v1.contacts()[1].friction.mu_roll, FrictionParams{}.mu_roll);
   EXPECT_EQ(v1.contacts()[1].restitution, 0.0);
   EXPECT_EQ(v1.contacts()[0].compliance, sys.contacts()[0].compliance);
   EXPECT_EQ(v1.params().max_recovery, 0.0);
-  const ContactSystem v2 = parse_system(older_version(sys, 2, 1, 1));
+  const ContactSystem v2 = parse_system(older_version(sys, 2, 1, 2));
   EXPECT_EQ(v2.contacts()[1].friction.mu, 0.3);
   EXPECT_EQ(v2.contacts()[1].restitution, 0.0);
   EXPECT_EQ(v2.params().max_recovery, 0.125);
   EXPECT_EQ(v2.params().bounce_speed, 0.0);
-  // the first contact line with a negative twisting coefficient, then a restitution of 2
-  std::string text = to_text(sys);
+  // the first contact line with a negative twisting coefficient, a restitution of 2 and a
+  // negative damping other than -1
+  const std::string text = to_text(sys);
   const std::size_t at = text.find("contacts ");
-  const std::size_t end = text.find('\n', text.find('\n', at) + 1);
-  const std::size_t last = text.rfind(' ', end - 1), coeff = text.rfind(' ', last - 1);
-  std::string bad = text;
-  bad.replace(coeff + 1, last - coeff - 1, "-1");
-  expect_error(bad, {"contact 0:", "mu_twist must not be negative"});
-  bad = text;
-  bad.replace(last + 1, end - last - 1, "2");
-  expect_error(bad, {"contact 0:", "restitution must be in [0, 1]"});
+  const std::size_t begin = text.find('\n', at) + 1, end = text.find('\n', begin);
+  std::vector<std::string> fields;
+  std::istringstream words(text.substr(begin, end - begin));
+  for (std::string w; words >> w;) fields.push_back(w);
+  ASSERT_EQ(fields.size(), 26u);
+  const auto with = [&](std::size_t index, const std::string &value) {
+    std::vector<std::string> f = fields;
+    f[index] = value;
+    std::string line;
+    for (const std::string &w : f) line += (line.empty() ? "" : " ") + w;
+    return text.substr(0, begin) + line + text.substr(end);
+  };
+  expect_error(with(23, "-1"), {"contact 0:", "mu_twist must not be negative"});
+  expect_error(with(24, "2"), {"contact 0:", "restitution must be in [0, 1]"});
+  expect_error(with(25, "-2"), {"contact 0:", "damping must be non-negative"});
+  EXPECT_EQ(parse_system(with(25, "-1")).contacts()[0].damping, -1.0);
 }
 
 TEST(SystemIo, FileRoundTripAndMissingFile)
@@ -277,7 +286,7 @@ TEST(SystemIo, EachMalformedInputGetsItsOwnError)
     const std::string cut = join(std::vector<std::string>(L.begin(), L.begin() + last)) +
                             L[last].substr(0, L[last].size() / 2);
     expect_error(cut, {line_tag(last), "contact " + std::to_string(sys.num_contacts() - 1) +
-                                           ": expected 25 values"});
+                                           ": expected 26 values"});
     expect_error(text.substr(0, text.size() - 4), {"unexpected end of input", "'end'"});
     std::vector<std::string> early(L.begin(), L.begin() + bodies + 3);
     expect_error(join(early), {line_tag(bodies), "body count 25 is more than the rest"});
@@ -320,7 +329,7 @@ TEST(SystemIo, EachMalformedInputGetsItsOwnError)
   expect_error(edit(contacts + 1, with_token(c0, 2, "2")), {"contact 0 normal is not a unit"});
   expect_error(edit(contacts + 1, with_token(c0, 15, "0")),
                {"contact 0: compliance of row 0 must be positive"});
-  expect_error(edit(contacts + 1, c0 + " 7"), {"contact 0: expected 25 values, found 26"});
+  expect_error(edit(contacts + 1, c0 + " 7"), {"contact 0: expected 26 values, found 27"});
 
   // Anything after the end, and binary junk.
   expect_error(text + "bodies 1 1\n", {"unexpected content after 'end'"});

@@ -30,7 +30,8 @@ SparseMatrix assemble_A(const ContactSystem &sys);
 SparseMatrix assemble_K(const ContactSystem &sys);
 
 // b = -(4/h) Upsilon g - (1 - Upsilon) G v - h G M^-1 f_ext with the assembled G (doc/design.md
-// section 2); g enters on active normal rows only.
+// section 2), Upsilon per contact (Contact::damping); g enters on active normal rows only. No
+// restitution: spook_rhs's impact law is not assembled here.
 Vector assemble_rhs(const ContactSystem &sys);
 
 // The upper triangle (row <= col) of a symmetric matrix as triplets, for MUMPS (SYM = 1).

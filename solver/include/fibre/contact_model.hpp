@@ -14,8 +14,11 @@ namespace fibre {
 // Sigma is a fixed small fraction of the lightest body's G M^-1 G^T entry whatever the step.
 // fixed: eps_n on the normal row, eps_t on the tangential rows. The rotational rows take
 // eps_t / r_eff^2 in both modes.
+// material: from the pair style's elastic laws where it has them (material_compliance()),
+// else automatic.
 struct ComplianceParams {
   bool automatic = true;
+  bool material = false;
   double eps_n = 0.0, eps_t = 0.0; // fixed mode
   double factor = 1e-2;            // automatic mode
 };
@@ -78,7 +81,10 @@ double cone_coefficient(const FrictionParams &f, double r_eff, int cone);
 // (m_min: the lightest body of the simulation, read by automatic compliance only). With
 // per-type coefficients a pair takes those of its bodies' types, a wall contact those of its
 // sphere's type with itself, and typed keywords override them.
+// `last` (optional, rows per contact) holds each contact's impulses of the last step, for
+// compliance material's reference load.
 void apply_contact_model(const ContactModel &model, double h, double m_min,
-                         const std::vector<Body> &bodies, std::vector<Contact> &contacts);
+                         const std::vector<Body> &bodies, std::vector<Contact> &contacts,
+                         const Vector *last = nullptr);
 
 } // namespace fibre

@@ -4,6 +4,7 @@
 // types, and what one contact takes from them (doc/design.md section 2, "Material").
 #pragma once
 
+#include <array>
 #include <string>
 #include <vector>
 
@@ -18,6 +19,14 @@ namespace fibre {
 //             (Marshall 2009, LAMMPS twisting marshall): vanishes for rigid contacts.
 enum class TwistLaw { none, sds, marshall };
 
+// The elastic laws of the pair style (`compliance material` linearizes the normal one):
+//   normal      hooke F = k_n d; hertz F = k_n sqrt(r_eff d) d (hertz/material: k_n = 4/3 E_eff);
+//   tangential  linear (k_t), mindlin (k_t a, a = sqrt(r_eff d) the contact radius);
+//   rolling     sds: torque k_roll r_eff^2 per unit angle; twisting sds: k_twist per unit angle,
+//               marshall: 0.5 k_t a^2 (mindlin).
+enum class NormalLaw { none, hooke, hertz, hertz_material };
+enum class TangentialLaw { none, linear, mindlin };
+
 struct PairCoefficients {
   bool set = false;
   double mu = 0.0;      // Coulomb
@@ -27,6 +36,12 @@ struct PairCoefficients {
   // Newton's coefficient of restitution, or < 0 when the pair style's damping law has none
   // (a viscous damping): the contact is then plastic unless the front end's keyword says more.
   double restitution = -1.0;
+  NormalLaw normal = NormalLaw::none; // none: no elastic constants (compliance auto)
+  double k_n = 0.0;
+  TangentialLaw tangential = TangentialLaw::none;
+  double k_t = 0.0;
+  double k_roll = 0.0;  // rolling sds, 0: none
+  double k_twist = 0.0; // twisting sds
 };
 
 // Symmetric table over types 1..ntypes.
@@ -57,5 +72,16 @@ double restitution_from_tsuji(double alpha);
 // The friction of one contact (radius r_eff, overlap >= 0) from its pair's coefficients:
 // mu_twist per unit r_eff as FrictionParams keeps it.
 FrictionParams contact_friction(const PairCoefficients &p, double r_eff, double overlap);
+
+// `compliance material` (doc/design.md section 2, "Material"): the normal row's secant
+// compliance of the normal law at the reference load F = max(the contact's last normal force,
+// the law's force at its overlap), so that a contact at rest under a steady load overlaps by
+// the law's d(F), and a native state at equilibrium is one here too. The other rows, and a
+// contact with F = 0 (new, not overlapping), keep `rigid` (the automatic compliance): they have
+// no displacement in the rhs, so a compliance there would be a viscosity (creep under a steady
+// load), not the law's spring. Returns false when p has no normal law.
+bool material_compliance(const PairCoefficients &p, double r_eff, double overlap, double last_force,
+                         const std::array<double, kMaxRows> &rigid,
+                         std::array<double, kMaxRows> &eps);
 
 } // namespace fibre

@@ -58,6 +58,9 @@ struct Contact {
   // A wall contact's partner type for per-type coefficients: an obstacle atom's type, or 0
   // for a wall (which takes the sphere's type).
   int wall_type = 0;
+  // This contact's SPOOK damping d (steps), or < 0 for the system's (SpookParams::damping):
+  // compliance material damps soft contacts critically.
+  double damping = -1.0;
   bool is_wall() const { return b < 0; }
 };
 
@@ -91,15 +94,20 @@ struct SpookParams {
   // Approach speeds at or below this are plastic whatever the contact's restitution (resting
   // contacts must not bounce on the speed gravity adds in a step).
   double bounce_speed = 0.0;
+  // A contact's damping: its own when set (Contact::damping >= 0), else the system's.
+  double damping_of(const Contact &c) const { return c.damping >= 0 ? c.damping : damping; }
   // The gap term of the normal row's rhs, -(4 / h) Upsilon g, bounded by max_recovery.
-  double gap_term(double gap) const
+  double gap_term(double gap, double ups) const
   {
-    const double term = -4.0 / h * upsilon() * gap;
+    const double term = -4.0 / h * ups * gap;
     return max_recovery > 0 && term > max_recovery ? max_recovery : term;
   }
-  double upsilon() const { return 1.0 / (1.0 + 4.0 * damping); }
+  double gap_term(double gap) const { return gap_term(gap, upsilon()); }
+  double upsilon(double d) const { return 1.0 / (1.0 + 4.0 * d); }
+  double upsilon() const { return upsilon(damping); }
   // Sigma entry for compliance eps: 4 eps / (h^2 (1 + 4 d)).
-  double sigma(double eps) const { return 4.0 * eps / (h * h * (1.0 + 4.0 * damping)); }
+  double sigma(double eps, double d) const { return 4.0 * eps / (h * h * (1.0 + 4.0 * d)); }
+  double sigma(double eps) const { return sigma(eps, damping); }
 };
 
 class ContactSystem {
