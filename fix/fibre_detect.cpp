@@ -33,9 +33,27 @@ void LammpsDetection::init_walls(const std::vector<fibre::WallSpec> &walls)
     if (regions_[w] < 0)
       error->all(FLERR,
                  "Region ID '" + id + "' for fix fibre_contact 'wall region' does not exist");
-    if (domain->regions[regions_[w]]->dynamic)
-      error->all(FLERR, "Fix fibre_contact does not support moving region '" + id +
-                            "' (walls must be at rest)");
+    Region *region = domain->regions[regions_[w]];
+    // A union or intersect takes `dynamic` from moving sub-regions, but LAMMPS gives the
+    // velocity of the combined region only (zero): its moving parts would act as static walls.
+    const std::string style = region->style;
+    if (region->dynamic && (style == "union" || style == "intersect"))
+      error->all(FLERR, "Fix fibre_contact 'wall region " + id + "': region style " + style +
+                            " with moving sub-regions has no surface velocity; give each moving "
+                            "sub-region its own 'wall region' keyword");
+    if (region->varshape)
+      error->all(FLERR, "Fix fibre_contact 'wall region " + id +
+                            "': a region whose shape changes over time (variable radius) is "
+                            "not supported; 'move' and 'rotate' are");
+  }
+}
+
+void LammpsDetection::start_moving_walls()
+{
+  for (int r : regions_) {
+    if (r < 0 || !domain->regions[r]->dynamic) continue;
+    domain->regions[r]->prematch();
+    domain->regions[r]->set_velocity();
   }
 }
 
@@ -118,7 +136,7 @@ void LammpsDetection::pair_contacts(const std::vector<fibre::Body> &bodies, doub
   NeighList *list = force->pair->list;
   const int nlocal = atom->nlocal;
   const tagint *tag = atom->tag;
-  double **x = atom->x;
+  double **x = atom->x, **v = atom->v, **omega = atom->omega;
   const double *radius = atom->radius;
   const bool newton_pair = force->newton_pair != 0;
   const double reach = neighbor->skin; // pairs beyond radsum + skin are not in the list
@@ -157,6 +175,11 @@ void LammpsDetection::pair_contacts(const std::vector<fibre::Body> &bodies, doub
         n = dist > 0.0 ? fibre::Vec3(n / dist) : fibre::Vec3::UnitZ();
         fc.contact = fibre::sphere_wall_contact(bodies, atom_body_[g], n, dist - radius[o]);
         fc.contact.wall_type = atom->type[o];
+        // a kinematic obstacle (moved by fix move or another fix): its velocity at the point
+        const fibre::Vec3 vo(v[o][0], v[o][1], v[o][2]), wo(omega[o][0], omega[o][1], omega[o][2]);
+        const fibre::Vec3 xo(x[o][0], x[o][1], x[o][2]);
+        fc.contact.wall_v = vo + wo.cross(fc.contact.point - xo);
+        fc.contact.wall_omega = wo;
         if (!fibre::is_contact(bodies[atom_body_[g]], nullptr, n, fc.contact.gap, h, damping))
           continue;
         fc.tag_a = tag[g];
@@ -204,6 +227,10 @@ void LammpsDetection::wall_contacts(const std::vector<fibre::Body> &bodies, doub
     }
     Region *region = domain->regions[regions_[w]];
     region->prematch();
+    // the surface velocity of a moving region: its displacement and rotation over the last
+    // step (LAMMPS's set_velocity, once per step whoever calls it)
+    const bool moving = region->dynamic;
+    if (moving) region->set_velocity();
     for (int k = 0; k < nowned; ++k) {
       const fibre::Body &b = bodies[k];
       const int nc =
@@ -212,8 +239,16 @@ void LammpsDetection::wall_contacts(const std::vector<fibre::Body> &bodies, doub
         const Region::Contact &rc = region->contact[c];
         if (!(rc.r > 0.0)) continue;
         const fibre::Vec3 n(rc.delx / rc.r, rc.dely / rc.r, rc.delz / rc.r);
+        const std::size_t before = found.size();
         add_wall_contact(bodies, k, n, rc.r, w, std::min(rc.iwall, fibre::kWallKeyStride - 1), h,
                          damping, found);
+        if (!moving || found.size() == before) continue;
+        double x[3] = {b.x[0], b.x[1], b.x[2]}, vwall[3];
+        region->velocity_contact(vwall, x, c);
+        fibre::Contact &contact = found.back().contact;
+        contact.wall_v = fibre::Vec3(vwall[0], vwall[1], vwall[2]);
+        if (region->rotateflag)
+          contact.wall_omega = fibre::Vec3(region->omega[0], region->omega[1], region->omega[2]);
       }
     }
   }

@@ -19,6 +19,9 @@ class LammpsDetection : protected LAMMPS_NS::Pointers {
 
   // Resolves region walls (region IDs to regions); call from init().
   void init_walls(const std::vector<fibre::WallSpec> &walls);
+  // At a run's setup: moving regions record their present position, so that the first step's
+  // surface velocity is that step's displacement (not the one since the region was defined).
+  void start_moving_walls();
 
   // The step's bodies: velocities and external forces of owned atoms, forwarded to ghosts.
   std::vector<fibre::Body> bodies();

@@ -255,6 +255,7 @@ void FixFibreContact::setup(int vflag)
 {
   v_init(vflag); // no contact forces before the run's first step: a zero virial
   first_step_ = true;
+  detection_->start_moving_walls();
   if (!force->pair || !force->pair->list)
     error->all(FLERR, std::string("Fix fibre_contact found no neighbor list of the pair style"));
   dtv_ = update->dt;

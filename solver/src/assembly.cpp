@@ -79,7 +79,9 @@ Vector assemble_rhs(const ContactSystem &sys)
     const Contact &k = sys.contacts()[c];
     const Eigen::Index row = Eigen::Index(sys.rows()) * c;
     const double ups_c = p.upsilon(p.damping_of(k));
-    for (int r = 0; r < sys.rows(); ++r) rhs[row + r] += (ups_c - ups) * Gv[row + r];
+    const std::array<double, kMaxRows> wall = wall_rows(k);
+    for (int r = 0; r < sys.rows(); ++r)
+      rhs[row + r] += (ups_c - ups) * Gv[row + r] + (1.0 - ups_c) * wall[r];
     if (sys.row_active(row)) rhs[row] += p.gap_term(k.gap, ups_c);
   }
   return rhs;

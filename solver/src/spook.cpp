@@ -39,7 +39,7 @@ Vector spook_rhs(const ContactSystem &sys, const Vector *extra_dv)
   // G v, where a contact bounces or has its own damping
   Vector Gv;
   for (const Contact &k : sys.contacts())
-    if (k.restitution > 0 || k.damping >= 0) {
+    if (k.restitution > 0 || k.damping >= 0 || k.wall_moves()) {
       g_apply(sys, body_velocities(sys), Gv);
       break;
     }
@@ -50,13 +50,18 @@ Vector spook_rhs(const ContactSystem &sys, const Vector *extra_dv)
     const double ups_c = p.upsilon(p.damping_of(k));
     if (k.damping >= 0) // -(1 - Upsilon_c) G v on every row of the contact
       for (int r = 0; r < rows; ++r) b[row + r] += (ups_c - ups) * Gv[row + r];
+    // A moving wall is body b with a prescribed velocity, the same after the step:
+    // -(1 - Upsilon) G v of the relative velocity, G_b w_b = -wall_rows.
+    const std::array<double, kMaxRows> wall = wall_rows(k);
+    if (k.wall_moves())
+      for (int r = 0; r < rows; ++r) b[row + r] += (1.0 - ups_c) * wall[r];
     if (!sys.row_active(row)) continue;
     const double b_spook = b[row] + p.gap_term(k.gap, ups_c);
     // Row: G_n v+ + eps lambda_n = G_n (v + h M^-1 f) + b_n, so b_n = 0 is free flight and
     // Newton's law G_n v+ = -e vn (vn = G_n v) is b_n = b_n(no gap) - (Upsilon + e) vn.
     // A contact that bounces keeps its approach speed until the step in which it closes:
     // SPOOK alone would brake it a step early (b > 0 asks for more than free flight).
-    const double vn = Gv.size() ? Gv[row] : 0.0;
+    const double vn = Gv.size() ? Gv[row] - wall[0] : 0.0; // relative normal velocity
     const bool bounces = k.restitution > 0 && -vn > p.bounce_speed;
     if (bounces && k.gap + p.h * vn <= 0) {
       // The compliance would keep Sigma / (w + Sigma) of the jump, w = 1/m_a + 1/m_b the

@@ -43,6 +43,17 @@ Contact sphere_wall_contact(const std::vector<Body> &bodies, int a, const Vec3 &
   return c;
 }
 
+std::array<double, kMaxRows> wall_rows(const Contact &c)
+{
+  std::array<double, kMaxRows> w{};
+  if (!c.wall_moves()) return w;
+  const Vec3 *frame[3] = {&c.normal, &c.t1, &c.t2};
+  for (int r = 0; r < 3; ++r) w[r] = frame[r]->dot(c.wall_v);
+  // rotational rows in the kernels' order: twist about n, then rolling about t1 and t2
+  for (int r = 0; r < 3; ++r) w[3 + r] = frame[r]->dot(c.wall_omega);
+  return w;
+}
+
 ContactSystem::ContactSystem(std::vector<Body> bodies, std::vector<Contact> contacts, int rows,
                              const SpookParams &params, int num_owned)
     : rows_(rows), params_(params), bodies_(std::move(bodies)), contacts_(std::move(contacts))

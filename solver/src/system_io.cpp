@@ -19,7 +19,8 @@ constexpr const char *kMagic = "fibre_contact_system";
 constexpr int kBodyFields = 17;
 constexpr int kContactFieldsV1 = 2 + 12 + 1 + kMaxRows;
 constexpr int kContactFieldsV2 = kContactFieldsV1 + 3; // + mu, mu_roll, mu_twist
-constexpr int kContactFields = kContactFieldsV2 + 2;   // version 3: + restitution, damping
+// version 3: + restitution, damping, wall velocity (3) and angular velocity (3)
+constexpr int kContactFields = kContactFieldsV2 + 8;
 // Unit vectors must read back as unit vectors; exported data are far more exact than this.
 constexpr double kUnitTol = 1e-6;
 
@@ -227,6 +228,7 @@ void write_system(std::ostream &out, const ContactSystem &sys)
       s += ' ';
       put_real(s, f);
     }
+    for (const Vec3 *v : {&c.wall_v, &c.wall_omega}) put_vec(s, *v);
     s += '\n';
     out << s;
   }
@@ -364,6 +366,10 @@ ContactSystem parse_system(std::string_view text)
     k.damping = in.real(t[kContactFieldsV2 + 1], what + " damping");
     if (!(k.damping >= 0 || k.damping == -1))
       in.fail(what + ": damping must be non-negative, or -1 for the system's");
+    k.wall_v = read_vec(in, t, kContactFieldsV2 + 2, what + " wall velocity");
+    k.wall_omega = read_vec(in, t, kContactFieldsV2 + 5, what + " wall angular velocity");
+    if (!k.is_wall() && (k.wall_v != Vec3::Zero() || k.wall_omega != Vec3::Zero()))
+      in.fail(what + ": a pair cannot have a wall velocity");
   }
 
   const long long dofs = rows * nc;

@@ -101,9 +101,13 @@ CASES = [
      {"pair": "", "post": GRAN}),
     ("pair_compute_yes", "", "pair style's force computation is on",
      {"post": "pair_modify compute yes"}),
-    ("moving_region", "wall region cup", "does not support moving region 'cup'",
-     {"pre": "variable vz equal 0.1*time\n"
-             "region cup cylinder z 0 0 2.5 0 5 side in move NULL NULL v_vz units box"}),
+    ("moving_union", "wall region cup", "region style union with moving sub-regions has no "
+     "surface velocity", {"pre": "variable vz equal 0.1*time\n"
+                         "region c1 cylinder z 0 0 2.5 0 5 side in move NULL NULL v_vz units box\n"
+                         "region c2 sphere 0 0 0 1 side in units box\n"
+                         "region cup union 2 c1 c2"}),
+    ("varshape_region", "wall region ball", "a region whose shape changes over time",
+     {"pre": "variable rad equal 2.0+0.1*time\nregion ball sphere 0 0 2 v_rad side in units box"}),
     ("two_d", "", "requires a 3d simulation", {"deck": TWO_D}),
     ("infinite_force", "", "non-finite force of atom 1 at step 1",
      {"pre": "fix push all addforce 0 0 1e400"}),

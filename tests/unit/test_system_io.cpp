@@ -80,7 +80,8 @@ void expect_identical(const ContactSystem &a, const ContactSystem &b)
                 same3(p.t2, q.t2) && same3(p.point, q.point) && same(p.gap, q.gap) &&
                 p.compliance == q.compliance && p.friction.mu == q.friction.mu &&
                 p.friction.mu_roll == q.friction.mu_roll &&
-                p.friction.mu_twist == q.friction.mu_twist && p.restitution == q.restitution)
+                p.friction.mu_twist == q.friction.mu_twist && p.restitution == q.restitution &&
+                p.damping == q.damping && p.wall_v == q.wall_v && p.wall_omega == q.wall_omega)
         << "contact " << c;
   }
   EXPECT_EQ(a.row_mask(), b.row_mask());
@@ -191,14 +192,14 @@ std::string older_version(const ContactSystem &sys, int version, int drop_spook,
 TEST(SystemIo, OlderVersionsAndCoefficientFields)
 {
   const ContactSystem sys = sample_system();
-  const ContactSystem v1 = parse_system(older_version(sys, 1, 2, 5));
+  const ContactSystem v1 = parse_system(older_version(sys, 1, 2, 11));
   ASSERT_EQ(v1.num_contacts(), sys.num_contacts());
   EXPECT_EQ(v1.contacts()[1].friction.mu, FrictionParams{}.mu);
   EXPECT_EQ(v1.contacts()[1].friction.mu_roll, FrictionParams{}.mu_roll);
   EXPECT_EQ(v1.contacts()[1].restitution, 0.0);
   EXPECT_EQ(v1.contacts()[0].compliance, sys.contacts()[0].compliance);
   EXPECT_EQ(v1.params().max_recovery, 0.0);
-  const ContactSystem v2 = parse_system(older_version(sys, 2, 1, 2));
+  const ContactSystem v2 = parse_system(older_version(sys, 2, 1, 8));
   EXPECT_EQ(v2.contacts()[1].friction.mu, 0.3);
   EXPECT_EQ(v2.contacts()[1].restitution, 0.0);
   EXPECT_EQ(v2.params().max_recovery, 0.125);
@@ -211,7 +212,7 @@ TEST(SystemIo, OlderVersionsAndCoefficientFields)
   std::vector<std::string> fields;
   std::istringstream words(text.substr(begin, end - begin));
   for (std::string w; words >> w;) fields.push_back(w);
-  ASSERT_EQ(fields.size(), 26u);
+  ASSERT_EQ(fields.size(), 32u);
   const auto with = [&](std::size_t index, const std::string &value) {
     std::vector<std::string> f = fields;
     f[index] = value;
@@ -223,6 +224,8 @@ TEST(SystemIo, OlderVersionsAndCoefficientFields)
   expect_error(with(24, "2"), {"contact 0:", "restitution must be in [0, 1]"});
   expect_error(with(25, "-2"), {"contact 0:", "damping must be non-negative"});
   EXPECT_EQ(parse_system(with(25, "-1")).contacts()[0].damping, -1.0);
+  if (sys.contacts()[0].is_wall()) return;
+  expect_error(with(26, "1"), {"contact 0:", "a pair cannot have a wall velocity"});
 }
 
 TEST(SystemIo, FileRoundTripAndMissingFile)
@@ -286,7 +289,7 @@ TEST(SystemIo, EachMalformedInputGetsItsOwnError)
     const std::string cut = join(std::vector<std::string>(L.begin(), L.begin() + last)) +
                             L[last].substr(0, L[last].size() / 2);
     expect_error(cut, {line_tag(last), "contact " + std::to_string(sys.num_contacts() - 1) +
-                                           ": expected 26 values"});
+                                           ": expected 32 values"});
     expect_error(text.substr(0, text.size() - 4), {"unexpected end of input", "'end'"});
     std::vector<std::string> early(L.begin(), L.begin() + bodies + 3);
     expect_error(join(early), {line_tag(bodies), "body count 25 is more than the rest"});
@@ -329,7 +332,7 @@ TEST(SystemIo, EachMalformedInputGetsItsOwnError)
   expect_error(edit(contacts + 1, with_token(c0, 2, "2")), {"contact 0 normal is not a unit"});
   expect_error(edit(contacts + 1, with_token(c0, 15, "0")),
                {"contact 0: compliance of row 0 must be positive"});
-  expect_error(edit(contacts + 1, c0 + " 7"), {"contact 0: expected 26 values, found 27"});
+  expect_error(edit(contacts + 1, c0 + " 7"), {"contact 0: expected 32 values, found 33"});
 
   // Anything after the end, and binary junk.
   expect_error(text + "bodies 1 1\n", {"unexpected content after 'end'"});

@@ -30,7 +30,8 @@ SparseMatrix assemble_A(const ContactSystem &sys);
 SparseMatrix assemble_K(const ContactSystem &sys);
 
 // b = -(4/h) Upsilon g - (1 - Upsilon) G v - h G M^-1 f_ext with the assembled G (doc/design.md
-// section 2), Upsilon per contact (Contact::damping); g enters on active normal rows only. No
+// section 2), Upsilon per contact (Contact::damping), moving walls as body b with a prescribed
+// velocity (+ (1 - Upsilon) wall_rows); g enters on active normal rows only. No
 // restitution: spook_rhs's impact law is not assembled here.
 Vector assemble_rhs(const ContactSystem &sys);
 

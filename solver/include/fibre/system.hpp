@@ -61,8 +61,21 @@ struct Contact {
   // This contact's SPOOK damping d (steps), or < 0 for the system's (SpookParams::damping):
   // compliance material damps soft contacts critically.
   double damping = -1.0;
+  // A moving wall or obstacle: its velocity at the contact point and its angular velocity
+  // (zero for walls at rest). They enter the rhs as the velocity of body b (spook_rhs).
+  Vec3 wall_v = Vec3::Zero();
+  Vec3 wall_omega = Vec3::Zero();
   bool is_wall() const { return b < 0; }
+  bool wall_moves() const
+  {
+    return b < 0 && (wall_v != Vec3::Zero() || wall_omega != Vec3::Zero());
+  }
 };
+
+// The rows of G times a moving wall's motion: (D wall_v, D wall_omega) for rows n, t1, t2,
+// twist, roll1, roll2 (D the contact frame), the part of the relative velocity that the wall
+// contributes with a minus sign. Zero for a pair or a wall at rest.
+std::array<double, kMaxRows> wall_rows(const Contact &c);
 
 // A deterministic orthonormal completion (t1, t2) of the unit vector n.
 void tangent_frame(const Vec3 &n, Vec3 &t1, Vec3 &t2);

@@ -1,0 +1,149 @@
+"""Moving walls and kinematic obstacles (issue #15).
+
+- Conveyor: a sphere dropped onto a block region that moves at U = 1 m/s (`region ... move`).
+  Friction drags it until it rolls without slipping on the belt: its centre then moves at
+  2 U / 7 (angular momentum about the contact point is conserved from rest). With a rolling
+  resistance that forbids rolling it moves with the belt, at U.
+- Drum: a sphere inside a cylinder that rotates about its axis at omega = 10 rad/s
+  (`region ... rotate`, omega^2 (R - r) = 25 g: a centrifuge). Friction and rolling resistance
+  carry it with the wall: its speed becomes omega (R - r), and over 10 revolutions it stays on
+  the wall (distance from the axis R - r within 1% of r: the step's straight drift overlaps
+  the curved wall by (h v)^2 / 2 (R - r)) without crossing it.
+- Obstacle: an atom outside the group moved by `fix move linear` pushes a free sphere
+  (frictionless, no gravity): the sphere moves at the obstacle's speed and the overlap stays
+  below that speed times dt.
+All serial and on two processes.
+"""
+
+import math
+
+import fibre_e2e as e2e
+
+DT = 1e-3
+
+
+def header(np, box):
+    lines = ["atom_style sphere", "atom_modify map array", "boundary f f f", "newton off",
+             "comm_modify vel yes"]
+    if np == 2:
+        lines.append("processors 2 1 1")
+    return lines + ["region box block %s units box" % box, "create_box 2 box"]
+
+
+def thermo(extra=""):
+    return [
+        "variable x1 equal x[1]",
+        "variable z1 equal z[1]",
+        "variable vx1 equal vx[1]",
+        "variable vy1 equal vy[1]",
+        "variable vz1 equal vz[1]",
+        "thermo_style custom step v_x1 v_z1 v_vx1 v_vy1 v_vz1 f_fc[7] " + extra,
+        "thermo_modify format float %.12g",
+    ]
+
+
+def conveyor(args, ck, np, mu_roll):
+    U = 1.0
+    lines = header(np, "-20 20 -3 3 -2 5") + [
+        "create_atoms 1 single -10 0 0.5 units box",
+        "set atom 1 diameter 1.0 density 1.0",
+        "variable shift equal %g*time" % U,
+        "region belt block -100 100 -2 2 -1 0 side out move v_shift NULL NULL units box",
+        "pair_style gran/hooke 1.0 NULL 0.0 NULL 0.5 0",
+        "pair_coeff * *",
+        "neighbor 0.2 bin",
+        "timestep %g" % DT,
+        "fix g all gravity 9.81 vector 0 0 -1",
+        "fix fc all fibre_contact wall region belt mu 0.5 mu_roll %g" % mu_roll,
+    ] + thermo() + ["thermo 100", "run 3000"]
+    tag = "conveyor_roll%g_np%d" % (mu_roll, np)
+    run = e2e.run_lmp(args, "\n".join(lines) + "\n", tag, np=np)
+    if not ck.ran(run, "%s: run completes" % tag):
+        return
+    last = run.thermo[-1][-1]
+    expected = U * (2.0 / 7.0 if mu_roll == 0 else 1.0)
+    ck.agree(last["v_vx1"], expected, 1e-3, "%s: the belt carries the sphere at %s" %
+             (tag, "2 U / 7 (rolling)" if mu_roll == 0 else "U (no rolling)"))
+    zs = run.column("v_z1")
+    ck.check(min(zs[1:]) > 0.5 - 0.01 and abs(last["v_vz1"]) < 1e-6,
+             "%s: the sphere stays on the belt's surface" % tag,
+             "lowest z %.6g, final vz %.3g" % (min(zs[1:]), last["v_vz1"]))
+
+
+def drum(args, ck, np):
+    R, r, omega = 3.0, 0.5, 10.0
+    revolutions = 10
+    steps = int(revolutions * 2 * math.pi / omega / DT)
+    lines = header(np, "-4 4 -2 2 -4 4") + [
+        "create_atoms 1 single 0 0 %g units box" % (-(R - r)),
+        "set atom 1 diameter 1.0 density 1.0",
+        "variable theta equal %g*time" % omega,
+        "region drum cylinder y 0 0 %g -1.5 1.5 side in rotate v_theta 0 0 0 0 1 0 units box" % R,
+        "pair_style gran/hooke 1.0 NULL 0.0 NULL 1.0 0",
+        "pair_coeff * *",
+        "neighbor 0.2 bin",
+        "timestep %g" % DT,
+        "fix g all gravity 9.81 vector 0 0 -1",
+        "fix fc all fibre_contact wall region drum mu 1.0 mu_roll 1.0",
+        "variable rho equal sqrt(x[1]^2+z[1]^2)",
+        "variable speed equal sqrt(vx[1]^2+vy[1]^2+vz[1]^2)",
+    ] + thermo("v_rho v_speed") + ["thermo 50", "run %d" % steps]
+    tag = "drum_np%d" % np
+    run = e2e.run_lmp(args, "\n".join(lines) + "\n", tag, np=np)
+    if not ck.ran(run, "%s: run completes" % tag):
+        return
+    rows = run.thermo[-1]
+    late = [row for row in rows if row["Step"] > steps // 2]
+    speed = [row["v_speed"] for row in late]
+    ck.check(all(abs(s - omega * (R - r)) < 1e-2 * omega * (R - r) for s in speed),
+             "%s: the sphere moves with the wall, at omega (R - r)" % tag,
+             "speeds %.5g .. %.5g against %.5g" % (min(speed), max(speed), omega * (R - r)))
+    rho = [row["v_rho"] for row in rows[1:]]
+    # the straight drift of a step leaves the circle by (h v)^2 / (2 (R - r)) = 1.25e-4 before
+    # the contact pulls the sphere back: overlaps of that order, far from crossing
+    ck.check(max(rho) < R - r + 0.01 * r and min(rho) > R - r - 0.01 * r,
+             "%s: %d revolutions on the wall, never through it" % (tag, revolutions),
+             "distance from the axis %.6g .. %.6g (R - r = %g)" % (min(rho), max(rho), R - r))
+    ck.check(rows[-1]["v_vy1"] == 0.0 or abs(rows[-1]["v_vy1"]) < 1e-9,
+             "%s: no motion along the axis" % tag, "vy %.3g" % rows[-1]["v_vy1"])
+
+
+def obstacle(args, ck, np):
+    u = 0.5
+    lines = header(np, "-5 10 -3 3 -3 3") + [
+        "create_atoms 1 single 0 0 0 units box",
+        "create_atoms 2 single -1.2 0 0 units box",
+        "set atom * diameter 1.0 density 1.0",
+        "group free type 1",
+        "group pusher type 2",
+        "pair_style gran/hooke 1.0 NULL 0.0 NULL 0.0 0",
+        "pair_coeff * *",
+        "neighbor 0.3 bin",
+        "timestep %g" % DT,
+        "fix push pusher move linear %g 0 0" % u,
+        "fix fc free fibre_contact mu 0",
+    ] + thermo() + ["thermo 100", "run 2000"]
+    tag = "obstacle_np%d" % np
+    run = e2e.run_lmp(args, "\n".join(lines) + "\n", tag, np=np)
+    if not ck.ran(run, "%s: run completes" % tag):
+        return
+    last = run.thermo[-1][-1]
+    ck.agree(last["v_vx1"], u, 1e-6, "%s: the pushed sphere moves at the obstacle's speed" % tag)
+    overlap = max(run.column("f_fc[7]"))
+    ck.check(overlap <= u * DT, "%s: the overlap stays below u dt" % tag,
+             "deepest %.3g against %.3g" % (overlap, u * DT))
+
+
+def main():
+    args = e2e.parse_args()
+    ck = e2e.Checks("moving walls and obstacles")
+    for np in (1, 2):
+        conveyor(args, ck, np, 0.0)
+        conveyor(args, ck, np, 1.0)
+        drum(args, ck, np)
+        obstacle(args, ck, np)
+    ck.close()
+
+
+if __name__ == "__main__":
+    main()
