@@ -218,10 +218,13 @@ void LammpsDetection::wall_contacts(const std::vector<fibre::Body> &bodies, doub
     if (walls_[w].kind != fibre::WallKind::region) {
       for (int k = 0; k < nowned; ++k) {
         fibre::PlaneHit hits[2];
-        const int n = fibre::plane_hits(walls_[w], bodies[k], skin, hits);
-        for (int s = 0; s < n; ++s)
+        const int n = fibre::plane_hits(walls_[w], bodies[k], skin, hits, wall_time_);
+        for (int s = 0; s < n; ++s) {
+          const std::size_t before = found.size();
           add_wall_contact(bodies, k, hits[s].normal, hits[s].distance, w, hits[s].sub, h, damping,
                            found);
+          if (found.size() > before) found.back().contact.wall_v = walls_[w].velocity(wall_time_);
+        }
       }
       continue;
     }

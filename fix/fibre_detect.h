@@ -26,6 +26,9 @@ class LammpsDetection : protected LAMMPS_NS::Pointers {
   // The step's bodies: velocities and external forces of owned atoms, forwarded to ghosts.
   std::vector<fibre::Body> bodies();
 
+  // The time since the fix was defined, for moving planes (wiggle, shear).
+  void set_wall_time(double t) { wall_time_ = t; }
+
   // Every contact this process keeps, in the library's order (fibre::sort_contacts).
   std::vector<fibre::DetectedContact> contacts(const std::vector<fibre::Body> &bodies, double h,
                                                double damping) const;
@@ -42,6 +45,7 @@ class LammpsDetection : protected LAMMPS_NS::Pointers {
   int groupbit_;
   LammpsExchange &exchange_;
   std::vector<fibre::WallSpec> walls_;
+  double wall_time_ = 0.0;
   std::vector<int> regions_;   // per wall: region index, or -1
   std::vector<int> atom_body_; // local atom -> body index, -1 if not a body
 };

@@ -74,6 +74,7 @@ FixFibreContact::FixFibreContact(LAMMPS *lmp, int narg, char **arg) : Fix(lmp, n
     error->all(FLERR, std::string("Illegal fix fibre_contact command: ") + e.what());
   }
 
+  time_origin_ = simulated_time(); // moving planes start their motion here, as fix wall/gran's
   exchange_ = std::make_unique<fibre_lmp::LammpsExchange>(lmp, this, world);
   detection_ = std::make_unique<fibre_lmp::LammpsDetection>(lmp, groupbit, *exchange_);
   output_ = std::make_unique<FibreOutput>(lmp);
@@ -92,6 +93,13 @@ FixFibreContact::FixFibreContact(LAMMPS *lmp, int narg, char **arg) : Fix(lmp, n
                                       "pair style ") +
                               force->pair_style + " (its neighbor list is the contact graph)\n");
   }
+}
+
+/* ---------------------------------------------------------------------- */
+
+double FixFibreContact::simulated_time() const
+{
+  return update->atime + (update->ntimestep - update->atimestep) * update->dt;
 }
 
 /* ---------------------------------------------------------------------- */
@@ -412,6 +420,7 @@ void FixFibreContact::final_integrate()
 
   const fibre::ContactModel &model = settings_.model;
   std::vector<fibre::Body> bodies = detection_->bodies();
+  detection_->set_wall_time(simulated_time() - time_origin_);
   std::vector<fibre::DetectedContact> found = detection_->contacts(bodies, dtv_, model.damping);
   smallest_body(bodies);
   fibre::SpookParams params{dtv_, model.damping, model.max_recovery(dtv_, r_min_)};

@@ -62,6 +62,7 @@ class FixFibreContact : public Fix {
   void check_finite(const char *what, double **array, int nvalues) const;
   void smallest_body(const std::vector<fibre::Body> &bodies);
   double bounce_speed(const std::vector<fibre::Body> &bodies) const;
+  double simulated_time() const;
   void tally_virial(const fibre::ContactSystem &sys, const fibre::Vector &lambda);
   void warn_deep_overlaps(const std::vector<fibre::Body> &bodies,
                           const std::vector<fibre::DetectedContact> &found, double max_recovery);
@@ -70,6 +71,7 @@ class FixFibreContact : public Fix {
 
   fibre::Settings settings_;
   double dtv_ = 0.0;
+  double time_origin_ = 0.0; // simulated time when the fix was defined (moving planes)
   static constexpr double kDeepOverlap = 0.05; // of the smaller diameter: warned at a run's start
   double m_min_ = 0.0, r_min_ = 0.0;
   bool first_step_ = true;

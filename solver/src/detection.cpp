@@ -1,5 +1,7 @@
 #include "fibre/detection.hpp"
 
+#include <cmath>
+
 #include <algorithm>
 
 namespace fibre {
@@ -21,19 +23,36 @@ double region_cutoff(const Body &b, double h, double damping, double skin)
   return b.radius * (1.0 + kContactMargin) + std::min(skin, (damping + 1.0) * h * vfree.norm());
 }
 
-int plane_hits(const WallSpec &wall, const Body &b, double reach, PlaneHit hits[2])
+double WallSpec::offset(double t) const
+{
+  if (motion != WallMotion::wiggle || motion_axis != axis()) return 0.0;
+  return amplitude * std::sin(2.0 * M_PI * t / period);
+}
+
+Vec3 WallSpec::velocity(double t) const
+{
+  Vec3 v = Vec3::Zero();
+  if (motion == WallMotion::wiggle)
+    v[motion_axis] = amplitude * 2.0 * M_PI / period * std::cos(2.0 * M_PI * t / period);
+  else if (motion == WallMotion::shear)
+    v[motion_axis] = shear_speed;
+  return v;
+}
+
+int plane_hits(const WallSpec &wall, const Body &b, double reach, PlaneHit hits[2], double t)
 {
   const int dim = wall.axis();
+  const double shift = wall.offset(t);
   int n = 0;
   if (wall.has_lo) {
-    const double distance = b.x[dim] - wall.lo;
+    const double distance = b.x[dim] - (wall.lo + shift);
     if (distance - b.radius < reach) {
       hits[n] = PlaneHit{Vec3::Zero(), distance, 0};
       hits[n++].normal[dim] = 1.0;
     }
   }
   if (wall.has_hi) {
-    const double distance = wall.hi - b.x[dim];
+    const double distance = wall.hi + shift - b.x[dim];
     if (distance - b.radius < reach) {
       hits[n] = PlaneHit{Vec3::Zero(), distance, 1};
       hits[n++].normal[dim] = -1.0;

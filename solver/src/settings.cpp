@@ -57,6 +57,30 @@ class Reader {
   const std::vector<std::string> &args_;
 };
 
+// Optional motion after a plane wall: "wiggle x|y|z <amplitude> <period>" or
+// "shear x|y|z <speed>" (fix wall/gran's keywords); returns the words read.
+std::size_t read_plane_motion(const Reader &in, std::size_t i, WallSpec &w)
+{
+  if (!in.has(i) || (in.at(i) != "wiggle" && in.at(i) != "shear")) return 0;
+  const bool wiggle = in.at(i) == "wiggle";
+  const std::string e = wiggle ? "'wiggle x|y|z <amplitude> <period>' (period > 0)"
+                               : "'shear x|y|z <speed>' (x, y or z in the wall's plane)";
+  if (!in.has(i + 1)) Reader::illegal(e);
+  const std::string &axis = in.at(i + 1);
+  if (axis != "x" && axis != "y" && axis != "z") Reader::illegal(e, &axis);
+  w.motion_axis = axis[0] - 'x';
+  if (wiggle) {
+    w.motion = WallMotion::wiggle;
+    w.amplitude = in.number(i + 2, e);
+    w.period = in.positive(i + 3, e);
+    return 4;
+  }
+  w.motion = WallMotion::shear;
+  if (w.motion_axis == w.axis()) Reader::illegal(e, &axis);
+  w.shear_speed = in.number(i + 2, e);
+  return 3;
+}
+
 // "wall xplane|yplane|zplane <lo|NULL> <hi|NULL>" or "wall region <region-ID>" at args[i];
 // returns the number of words read.
 std::size_t read_wall(const Reader &in, std::size_t i, WallSpec &w)
@@ -85,7 +109,7 @@ std::size_t read_wall(const Reader &in, std::size_t i, WallSpec &w)
   if (!w.has_lo && !w.has_hi) Reader::illegal(ep + " with at least one of lo and hi a number");
   const std::string both = lo + " " + hi;
   if (w.has_lo && w.has_hi && !(w.lo < w.hi)) Reader::illegal(ep + " with lo < hi", &both);
-  return 4;
+  return 4 + read_plane_motion(in, i + 4, w);
 }
 
 // The solver keywords; returns the words read, 0 when `key` is not one of them.

@@ -12,6 +12,9 @@
 - Obstacle: an atom outside the group moved by `fix move linear` pushes a free sphere
   (frictionless, no gravity): the sphere moves at the obstacle's speed and the overlap stays
   below that speed times dt.
+- Moving planes (fix wall/gran's keywords): a sphere on a zplane that shears along x at U
+  ends at 2 U / 7, rolling without slipping; on a plane wiggling along z with A omega^2 below
+  g it follows the plane (z = r + A sin(omega t)); above g it leaves the plane.
 All serial and on two processes.
 """
 
@@ -134,6 +137,45 @@ def obstacle(args, ck, np):
              "deepest %.3g against %.3g" % (overlap, u * DT))
 
 
+def plane(args, ck, np, motion, tag):
+    lines = header(np, "-20 20 -3 3 -2 5") + [
+        "create_atoms 1 single -10 0 0.5 units box",
+        "set atom 1 diameter 1.0 density 1.0",
+        "pair_style gran/hooke 1.0 NULL 0.0 NULL 0.5 0",
+        "pair_coeff * *",
+        "neighbor 0.2 bin",
+        "timestep %g" % DT,
+        "fix g all gravity 9.81 vector 0 0 -1",
+        "fix fc all fibre_contact wall zplane 0.0 NULL %s" % motion,
+        "variable t equal time",
+    ] + thermo("v_t") + ["thermo 10", "run 3000"]
+    run = e2e.run_lmp(args, "\n".join(lines) + "\n", tag, np=np)
+    ck.ran(run, "%s: run completes" % tag)
+    return run
+
+
+def planes(args, ck, np):
+    U = 1.0
+    run = plane(args, ck, np, "shear x %g" % U, "plane_shear_np%d" % np)
+    if run.rc == 0:
+        ck.agree(run.last("v_vx1"), 2.0 * U / 7.0, 1e-3,
+                 "plane_shear_np%d: the shearing plane rolls the sphere at 2 U / 7" % np)
+    A, T = 0.01, 0.5  # A omega^2 = 1.58 < g
+    run = plane(args, ck, np, "wiggle z %g %g" % (A, T), "plane_wiggle_np%d" % np)
+    if run.rc == 0:
+        rows = run.thermo[-1][1:]
+        dev = max(abs(r["v_z1"] - 0.5 - A * math.sin(2 * math.pi * r["v_t"] / T)) for r in rows)
+        ck.check(dev < 0.02 * A, "plane_wiggle_np%d: the sphere rides the wiggling plane" % np,
+                 "largest deviation %.3g against amplitude %g" % (dev, A))
+    A, T = 0.1, 0.2  # A omega^2 = 98.7 > g
+    run = plane(args, ck, np, "wiggle z %g %g" % (A, T), "plane_shaker_np%d" % np)
+    if run.rc == 0:
+        lift = max(r["v_z1"] - 0.5 - A * math.sin(2 * math.pi * r["v_t"] / T)
+                   for r in run.thermo[-1][1:])
+        ck.check(lift > A, "plane_shaker_np%d: a plane shaken harder than g throws it" % np,
+                 "largest height above the plane %.3g" % lift)
+
+
 def main():
     args = e2e.parse_args()
     ck = e2e.Checks("moving walls and obstacles")
@@ -142,6 +184,7 @@ def main():
         conveyor(args, ck, np, 1.0)
         drum(args, ck, np)
         obstacle(args, ck, np)
+        planes(args, ck, np)
     ck.close()
 
 

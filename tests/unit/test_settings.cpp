@@ -161,3 +161,32 @@ TEST(Settings, BadInputNamesTheKeywordAndItsForm)
   EXPECT_NE(error_of("speed 3").find("expected a keyword (form, solver"), std::string::npos);
   EXPECT_NE(error_of("speed 3").find("got 'speed'"), std::string::npos);
 }
+
+// Moving planes: fix wall/gran's wiggle and shear after a plane's bounds, their offset and
+// velocity in time, and their errors.
+TEST(Settings, MovingPlanes)
+{
+  const Settings s = parse_settings(
+      words("wall zplane 0 NULL wiggle z 0.1 0.5 wall xplane -2 2 shear y 1.5 mu 0.3"));
+  ASSERT_EQ(s.walls.size(), 2u);
+  const WallSpec &w = s.walls[0];
+  EXPECT_EQ(w.motion, WallMotion::wiggle);
+  EXPECT_NEAR(w.offset(0.125), 0.1, 1e-15); // a quarter period
+  EXPECT_NEAR(w.velocity(0.0)[2], 0.1 * 2 * M_PI / 0.5, 1e-12);
+  const WallSpec &x = s.walls[1];
+  EXPECT_EQ(x.motion, WallMotion::shear);
+  EXPECT_EQ(x.offset(3.0), 0.0);
+  EXPECT_EQ(x.velocity(3.0), Vec3(0, 1.5, 0));
+  EXPECT_DOUBLE_EQ(s.model.friction.mu, 0.3); // parsing goes on after the motion
+  // an in-plane wiggle slides the plane without moving it
+  const Settings t = parse_settings(words("wall zplane 0 NULL wiggle x 0.1 0.5"));
+  EXPECT_EQ(t.walls[0].offset(0.125), 0.0);
+  EXPECT_NEAR(t.walls[0].velocity(0.0)[0], 0.1 * 2 * M_PI / 0.5, 1e-12);
+  // a plane sheared along its own normal, a bad axis, a zero period
+  EXPECT_EQ(error_of("wall zplane 0 NULL shear z 1"),
+            "expected 'shear x|y|z <speed>' (x, y or z in the wall's plane), got 'z'");
+  EXPECT_EQ(error_of("wall zplane 0 NULL wiggle w 1 1"),
+            "expected 'wiggle x|y|z <amplitude> <period>' (period > 0), got 'w'");
+  EXPECT_EQ(error_of("wall zplane 0 NULL wiggle z 1 0"),
+            "expected 'wiggle x|y|z <amplitude> <period>' (period > 0), got '0'");
+}

@@ -31,12 +31,24 @@ template <> struct EnumNames<WallKind> {
                                                  {WallKind::region, "region"}};
 };
 
+// How a plane wall moves (fix wall/gran's keywords): wiggle = oscillation along motion_axis,
+// amplitude * sin(2 pi t / period) (the planes move when that is their own axis, else they
+// slide in their plane); shear = sliding in the plane at shear_speed along motion_axis.
+enum class WallMotion { none, wiggle, shear };
+
 struct WallSpec {
   WallKind kind = WallKind::zplane;
   bool has_lo = false, has_hi = false;
   double lo = 0.0, hi = 0.0;
   std::string region_id;
+  WallMotion motion = WallMotion::none;
+  int motion_axis = 0;
+  double amplitude = 0.0, period = 1.0, shear_speed = 0.0;
   int axis() const { return static_cast<int>(kind); } // planes: 0 x, 1 y, 2 z
+  // The planes' displacement along their own axis and their velocity at time t since the
+  // wall was defined.
+  double offset(double t) const;
+  Vec3 velocity(double t) const;
 };
 
 // A pair is a contact when its gap is below kContactMargin of the smaller radius, or when it
@@ -57,7 +69,8 @@ struct PlaneHit {
   double distance;
   int sub;
 };
-int plane_hits(const WallSpec &wall, const Body &b, double reach, PlaneHit hits[2]);
+// t: time since the wall was defined (moving planes).
+int plane_hits(const WallSpec &wall, const Body &b, double reach, PlaneHit hits[2], double t = 0.0);
 
 // One contact found by a front end, before the system is built.
 struct DetectedContact {
