@@ -316,8 +316,10 @@ def table(scene, n, R):
     row("spheres inserted (max atoms)", "atoms_max", "%d", rel=False)
     row("spheres at the end", "atoms_end", "%d", rel=False)
     if scene == "material":
-        nat["lost"] = nat["atoms_max"] - nat["atoms_end"]
-        fib["lost"] = fib["atoms_max"] - fib["atoms_end"]
+        # The pour inserts all n spheres before the run ends; max - end alone would miss a
+        # sphere lost while the count still grows.
+        for r in (nat, fib):
+            r["lost"] = max(r["atoms_max"], n) - r["atoms_end"]
         row("lost off the plane", "lost", "%d", rel=False)
         row("pile height, highest sphere top (m)", "height", "%.3f")
         row("angle of repose (deg, mean of 4 quadrants)", "angle", "%.1f")
