@@ -30,8 +30,10 @@ class LammpsDetection : protected LAMMPS_NS::Pointers {
   void set_wall_time(double t) { wall_time_ = t; }
 
   // Every contact this process keeps, in the library's order (fibre::sort_contacts).
+  // impacts: contacts may bounce (restitution), so a body hit within the step may move faster
+  // than its own velocity says; the contacts it can then reach are kept too (collective).
   std::vector<fibre::DetectedContact> contacts(const std::vector<fibre::Body> &bodies, double h,
-                                               double damping) const;
+                                               double damping, bool impacts = false);
 
  private:
   void pair_contacts(const std::vector<fibre::Body> &bodies, double h, double damping,
@@ -42,10 +44,13 @@ class LammpsDetection : protected LAMMPS_NS::Pointers {
                         double distance, int wall, int sub, double h, double damping,
                         std::vector<fibre::DetectedContact> &found) const;
 
+  double kick(int body) const { return kick_.empty() ? 0.0 : kick_[body]; }
+
   int groupbit_;
   LammpsExchange &exchange_;
   std::vector<fibre::WallSpec> walls_;
   double wall_time_ = 0.0;
+  std::vector<double> kick_;   // per body: the speed an impact may give it this step
   std::vector<int> regions_;   // per wall: region index, or -1
   std::vector<int> atom_body_; // local atom -> body index, -1 if not a body
 };

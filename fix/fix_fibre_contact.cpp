@@ -23,6 +23,7 @@
 #include "domain.h"
 #include "error.h"
 #include "fibre_detect.h"
+#include "fibre/spook.hpp"
 #include "fibre/stress.hpp"
 #include "fibre/text.hpp"
 #include "fibre_output.h"
@@ -421,7 +422,8 @@ void FixFibreContact::final_integrate()
   const fibre::ContactModel &model = settings_.model;
   std::vector<fibre::Body> bodies = detection_->bodies();
   detection_->set_wall_time(simulated_time() - time_origin_);
-  std::vector<fibre::DetectedContact> found = detection_->contacts(bodies, dtv_, model.damping);
+  std::vector<fibre::DetectedContact> found =
+      detection_->contacts(bodies, dtv_, model.damping, model.may_bounce());
   smallest_body(bodies);
   fibre::SpookParams params{dtv_, model.damping, model.max_recovery(dtv_, r_min_)};
   params.bounce_speed = bounce_speed(bodies);
@@ -435,6 +437,7 @@ void FixFibreContact::final_integrate()
   std::vector<fibre::Contact> contacts;
   for (const fibre::DetectedContact &fc : found) contacts.push_back(fc.contact);
   const fibre::Vector warm = history_.warm_start(found, model.rows, dtv_);
+  history_.load_springs(found, contacts);
   if (any) fibre::apply_contact_model(model, dtv_, m_min_, bodies, contacts, &warm);
   fibre::ContactSystem sys(std::move(bodies), std::move(contacts), model.rows, params,
                            exchange_->num_owned());
@@ -445,7 +448,12 @@ void FixFibreContact::final_integrate()
   update_velocities(res.dv.size() > 0 ? &res.dv : nullptr);
   if (evflag) // this step's virial is wanted (post_force)
     tally_virial(sys, res.lambda.size() ? res.lambda : fibre::Vector::Zero(sys.contact_dofs()));
-  overflow_count_ += history_.store(found, res.lambda, model.rows, dtv_, atom->nlocal);
+  // the elastic rows' springs (compliance material; collective, so on every process)
+  std::vector<std::array<double, fibre::kMaxRows>> springs;
+  if (any && model.compliance.material)
+    springs = fibre::advance_springs(sys, *exchange_, res.lambda);
+  overflow_count_ += history_.store(found, res.lambda, model.rows, dtv_, atom->nlocal,
+                                    springs.empty() ? nullptr : &springs);
 
   // report
   output_->fill_local(found, any ? &res.lambda : nullptr, model.rows, array_local, size_local_rows);
@@ -522,7 +530,12 @@ void FixFibreContact::unpack_restart(int nlocal, int nth)
   int m = 0;
   for (int k = 0; k < nth; ++k) m += static_cast<int>(extra[m]);
   const int count = static_cast<int>(extra[m]);
-  history_.unpack(nlocal, extra + m + 1, count - 2);
+  // restart files written before the springs hold 7 values per slot
+  const int n = static_cast<int>(extra[m + 1]);
+  const int slot = n > 0 && count - 2 == n * fibre::ContactHistory::kWarmStartSlot
+                       ? fibre::ContactHistory::kWarmStartSlot
+                       : fibre::ContactHistory::kSlotSize;
+  history_.unpack(nlocal, extra + m + 1, count - 2, slot);
 }
 
 int FixFibreContact::size_restart(int i)

@@ -82,6 +82,9 @@ Vector assemble_rhs(const ContactSystem &sys)
     const std::array<double, kMaxRows> wall = wall_rows(k);
     for (int r = 0; r < sys.rows(); ++r)
       rhs[row + r] += (ups_c - ups) * Gv[row + r] + (1.0 - ups_c) * wall[r];
+    for (int r = 1; r < sys.rows(); ++r)
+      if (k.elastic[r] && sys.row_active(row + r))
+        rhs[row + r] += p.spring_term(k.spring[r], ups_c);
     if (sys.row_active(row)) rhs[row] += p.gap_term(k.gap, ups_c);
   }
   return rhs;

@@ -26,13 +26,18 @@ int ContactHistory::pack(int i, double *buf) const
   return packed_size(i);
 }
 
-int ContactHistory::unpack(int i, const double *buf, int available)
+int ContactHistory::unpack(int i, const double *buf, int available, int slot_size)
 {
+  slot_size = std::clamp(slot_size, 1, kSlotSize);
   const int n = std::min(
-      {kMaxSlots, std::max(0, static_cast<int>(buf[0])), std::max(0, available) / kSlotSize});
+      {kMaxSlots, std::max(0, static_cast<int>(buf[0])), std::max(0, available) / slot_size});
   count_[i] = n;
-  std::copy(buf + 1, buf + 1 + n * kSlotSize, &slots_[std::size_t(i) * kMaxSlots * kSlotSize]);
-  return 1 + n * kSlotSize;
+  double *dst = &slots_[std::size_t(i) * kMaxSlots * kSlotSize];
+  for (int k = 0; k < n; ++k, dst += kSlotSize) {
+    std::copy(buf + 1 + k * slot_size, buf + 1 + (k + 1) * slot_size, dst);
+    std::fill(dst + slot_size, dst + kSlotSize, 0.0);
+  }
+  return 1 + n * slot_size;
 }
 
 double ContactHistory::memory_bytes() const
@@ -65,8 +70,39 @@ Vector ContactHistory::warm_start(const std::vector<DetectedContact> &found, int
   return warm;
 }
 
+namespace {
+
+// v turned into the plane normal to n, its length kept.
+Vec3 into_plane(const Vec3 &v, const Vec3 &n)
+{
+  const Vec3 p = v - v.dot(n) * n;
+  const double lp = p.norm();
+  return lp > 0 ? Vec3(v.norm() / lp * p) : Vec3::Zero();
+}
+
+} // namespace
+
+void ContactHistory::load_springs(const std::vector<DetectedContact> &found,
+                                  std::vector<Contact> &contacts) const
+{
+  for (std::size_t c = 0; c < found.size(); ++c) {
+    Contact &k = contacts[c];
+    k.spring.fill(0.0);
+    const double *slot = find(found[c].store, found[c].key);
+    if (!slot) continue;
+    const Vec3 tangential = into_plane(Vec3(slot[7], slot[8], slot[9]), k.normal);
+    const Vec3 rolling = into_plane(Vec3(slot[10], slot[11], slot[12]), k.normal);
+    k.spring[1] = tangential.dot(k.t1);
+    k.spring[2] = tangential.dot(k.t2);
+    k.spring[3] = slot[13];
+    k.spring[4] = rolling.dot(k.t1);
+    k.spring[5] = rolling.dot(k.t2);
+  }
+}
+
 long ContactHistory::store(const std::vector<DetectedContact> &found, const Vector &lambda,
-                           int rows, double h, int nlocal)
+                           int rows, double h, int nlocal,
+                           const std::vector<std::array<double, kMaxRows>> *springs)
 {
   std::fill(count_.begin(), count_.begin() + nlocal, 0);
   long overflow = 0;
@@ -85,10 +121,21 @@ long ContactHistory::store(const std::vector<DetectedContact> &found, const Vect
     }
     double *slot = &slots_[(std::size_t(s) * kMaxSlots + count_[s]++) * kSlotSize];
     slot[0] = fc.key;
+    Vec3 tangential = Vec3::Zero(), rolling = Vec3::Zero();
+    double twisting = 0.0;
+    if (springs) {
+      const std::array<double, kMaxRows> &xi = (*springs)[c];
+      tangential = xi[1] * k.t1 + xi[2] * k.t2;
+      rolling = xi[4] * k.t1 + xi[5] * k.t2;
+      twisting = xi[3];
+    }
     for (int d = 0; d < 3; ++d) {
       slot[1 + d] = force[d];
       slot[4 + d] = moment[d];
+      slot[7 + d] = tangential[d];
+      slot[10 + d] = rolling[d];
     }
+    slot[13] = twisting;
   }
   return overflow;
 }

@@ -17,6 +17,37 @@ double cone_coefficient(const FrictionParams &f, double r_eff, int cone)
   return (cone == 1 ? f.mu_twist : f.mu_roll) * r_eff;
 }
 
+namespace {
+
+// Contact c's coefficients from its type pair's (pc), and with compliance material its rows'
+// compliances, springs and damping.
+void apply_pair(const ContactModel &model, const PairCoefficients &pc, double h, double reff,
+                const std::vector<Body> &bodies, const Vector *last, std::size_t k, Contact &c)
+{
+  const double overlap = std::max(-c.gap, 0.0);
+  const FrictionParams f = contact_friction(pc, reff, overlap);
+  const TypedCoefficients &typed = model.typed;
+  if (!typed.mu) c.friction.mu = f.mu;
+  if (!typed.mu_roll) c.friction.mu_roll = f.mu_roll;
+  if (!typed.mu_twist) c.friction.mu_twist = f.mu_twist;
+  if (!typed.restitution && pc.restitution >= 0) c.restitution = pc.restitution;
+  if (!model.compliance.material) return;
+  const int rows = model.rows;
+  const bool has_last = last && last->size() >= Eigen::Index(rows) * Eigen::Index(k + 1);
+  const double force = has_last ? std::max((*last)[Eigen::Index(rows) * k], 0.0) / h : 0.0;
+  const std::array<double, kMaxRows> rigid = c.compliance;
+  material_compliance(pc, reff, overlap, force, rigid, c.compliance, c.elastic);
+  for (int r = rows; r < kMaxRows; ++r) c.elastic[r] = false;
+  // Soft contacts get at least critical damping, tau = 2 sqrt(m_eff eps) (SPOOK's d = 2
+  // would leave a Hertz column ringing): at rest they sit still, bounces come from e.
+  const double ma = bodies[c.a].mass;
+  const double m_eff = c.is_wall() ? ma : ma * bodies[c.b].mass / (ma + bodies[c.b].mass);
+  const double critical = 2.0 * std::sqrt(m_eff * c.compliance[0]) / h;
+  if (critical > model.damping) c.damping = critical;
+}
+
+} // namespace
+
 void apply_contact_model(const ContactModel &model, double h, double m_min,
                          const std::vector<Body> &bodies, std::vector<Contact> &contacts,
                          const Vector *last)
@@ -24,7 +55,6 @@ void apply_contact_model(const ContactModel &model, double h, double m_min,
   const ComplianceParams &p = model.compliance;
   double eps_n = p.eps_n, eps_t = p.eps_t;
   if (p.automatic || p.material) eps_n = eps_t = p.factor * h * h / m_min;
-  const int rows = model.rows;
   for (std::size_t k = 0; k < contacts.size(); ++k) {
     Contact &c = contacts[k];
     const double reff = effective_radius(bodies, c);
@@ -33,32 +63,26 @@ void apply_contact_model(const ContactModel &model, double h, double m_min,
     for (int r = 3; r < kMaxRows; ++r) c.compliance[r] = eps_t / (reff * reff);
     c.friction = model.friction;
     c.restitution = model.restitution;
-    if (!model.per_type()) continue;
+    c.elastic.fill(false);
     const int ta = bodies[c.a].type;
     const int tb = !c.is_wall() ? bodies[c.b].type : c.wall_type > 0 ? c.wall_type : ta;
-    if (ta < 1 || tb < 1 || ta > model.materials.ntypes() || tb > model.materials.ntypes())
-      continue; // no type: the model's values
-    const PairCoefficients &pc = model.materials.at(ta, tb);
-    const double overlap = std::max(-c.gap, 0.0);
-    const FrictionParams f = contact_friction(pc, reff, overlap);
-    const TypedCoefficients &typed = model.typed;
-    if (!typed.mu) c.friction.mu = f.mu;
-    if (!typed.mu_roll) c.friction.mu_roll = f.mu_roll;
-    if (!typed.mu_twist) c.friction.mu_twist = f.mu_twist;
-    if (!typed.restitution && pc.restitution >= 0) c.restitution = pc.restitution;
-    if (p.material) {
-      const bool has_last = last && last->size() >= Eigen::Index(rows) * Eigen::Index(k + 1);
-      const double force = has_last ? std::max((*last)[Eigen::Index(rows) * k], 0.0) / h : 0.0;
-      const std::array<double, kMaxRows> rigid = c.compliance;
-      material_compliance(pc, reff, overlap, force, rigid, c.compliance);
-      // Soft contacts get at least critical damping, tau = 2 sqrt(m_eff eps) (SPOOK's d = 2
-      // would leave a Hertz column ringing): at rest they sit still, bounces come from e.
-      const double ma = bodies[c.a].mass;
-      const double m_eff = c.is_wall() ? ma : ma * bodies[c.b].mass / (ma + bodies[c.b].mass);
-      const double critical = 2.0 * std::sqrt(m_eff * c.compliance[0]) / h;
-      if (critical > model.damping) c.damping = critical;
-    }
+    const int ntypes = model.materials.ntypes();
+    if (model.per_type() && ta >= 1 && tb >= 1 && ta <= ntypes && tb <= ntypes)
+      apply_pair(model, model.materials.at(ta, tb), h, reff, bodies, last, k, c);
+    // a spring's displacement lives on elastic rows only
+    for (int r = 0; r < kMaxRows; ++r)
+      if (!c.elastic[r]) c.spring[r] = 0.0;
   }
+}
+
+bool ContactModel::may_bounce() const
+{
+  if (restitution > 0) return true;
+  if (!per_type() || typed.restitution) return false;
+  for (int i = 1; i <= materials.ntypes(); ++i)
+    for (int j = i; j <= materials.ntypes(); ++j)
+      if (materials.at(i, j).restitution > 0) return true;
+  return false;
 }
 
 double external_speed_per_step(const std::vector<Body> &bodies, int num_owned, double h)

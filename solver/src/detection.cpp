@@ -6,10 +6,11 @@
 
 namespace fibre {
 
-bool is_contact(const Body &a, const Body *b, const Vec3 &n, double gap, double h, double damping)
+bool is_contact(const Body &a, const Body *b, const Vec3 &n, double gap, double h, double damping,
+                double kick)
 {
   const double rmin = b ? std::min(a.radius, b->radius) : a.radius;
-  const double margin = kContactMargin * rmin;
+  const double margin = kContactMargin * rmin + (damping + 1.0) * h * kick;
   if (gap < margin) return true;
   Vec3 rel = a.v + (h / a.mass) * a.force;
   if (b) rel -= b->v + (h / b->mass) * b->force;

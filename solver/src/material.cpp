@@ -98,9 +98,10 @@ FrictionParams contact_friction(const PairCoefficients &p, double r_eff, double 
 
 bool material_compliance(const PairCoefficients &p, double r_eff, double overlap, double last_force,
                          const std::array<double, kMaxRows> &rigid,
-                         std::array<double, kMaxRows> &eps)
+                         std::array<double, kMaxRows> &eps, std::array<bool, kMaxRows> &elastic)
 {
   eps = rigid;
+  elastic.fill(false);
   if (p.normal == NormalLaw::none || !(p.k_n > 0) || !(r_eff > 0)) return false;
   const bool hertz = p.normal != NormalLaw::hooke;
   const double d_now = std::max(overlap, 0.0);
@@ -110,6 +111,21 @@ bool material_compliance(const PairCoefficients &p, double r_eff, double overlap
   // the law's overlap at the reference load, and its contact radius
   const double d = hertz ? std::cbrt(f * f / (p.k_n * p.k_n * r_eff)) : f / p.k_n;
   eps[0] = d / f;
+  const double a = std::sqrt(r_eff * d);
+  // the springs, each with its displacement in the rhs (Contact::spring)
+  const double k_t = p.tangential == TangentialLaw::mindlin  ? p.k_t * a
+                     : p.tangential == TangentialLaw::linear ? p.k_t
+                                                             : 0.0;
+  const double k_twist = p.twist == TwistLaw::marshall ? 0.5 * k_t * a * a
+                         : p.twist == TwistLaw::sds    ? p.k_twist
+                                                       : 0.0;
+  const double k_roll = p.k_roll * r_eff * r_eff; // torque per unit angle
+  const double stiffness[kMaxRows] = {0.0, k_t, k_t, k_twist, k_roll, k_roll};
+  for (int r = 1; r < kMaxRows; ++r)
+    if (stiffness[r] > 0) {
+      eps[r] = 1.0 / stiffness[r];
+      elastic[r] = true;
+    }
   return true;
 }
 

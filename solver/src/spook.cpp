@@ -2,6 +2,7 @@
 
 #include <algorithm>
 
+#include "fibre/cones.hpp"
 #include "fibre/kernels.hpp"
 
 namespace fibre {
@@ -31,7 +32,8 @@ Vector spook_rhs(const ContactSystem &sys, const Vector *extra_dv)
 {
   const SpookParams &p = sys.params();
   const double ups = p.upsilon();
-  Vector w = (1.0 - ups) * body_velocities(sys) + external_velocity_change(sys);
+  const Vector v = body_velocities(sys);
+  Vector w = (1.0 - ups) * v + external_velocity_change(sys);
   if (extra_dv) w += *extra_dv;
   Vector b;
   g_apply(sys, w, b);
@@ -40,7 +42,7 @@ Vector spook_rhs(const ContactSystem &sys, const Vector *extra_dv)
   Vector Gv;
   for (const Contact &k : sys.contacts())
     if (k.restitution > 0 || k.damping >= 0 || k.wall_moves()) {
-      g_apply(sys, body_velocities(sys), Gv);
+      g_apply(sys, v, Gv);
       break;
     }
   const int rows = sys.rows();
@@ -55,6 +57,8 @@ Vector spook_rhs(const ContactSystem &sys, const Vector *extra_dv)
     const std::array<double, kMaxRows> wall = wall_rows(k);
     if (k.wall_moves())
       for (int r = 0; r < rows; ++r) b[row + r] += (1.0 - ups_c) * wall[r];
+    for (int r = 1; r < rows; ++r)
+      if (k.elastic[r] && sys.row_active(row + r)) b[row + r] += p.spring_term(k.spring[r], ups_c);
     if (!sys.row_active(row)) continue;
     const double b_spook = b[row] + p.gap_term(k.gap, ups_c);
     // Row: G_n v+ + eps lambda_n = G_n (v + h M^-1 f) + b_n, so b_n = 0 is free flight and
@@ -62,16 +66,19 @@ Vector spook_rhs(const ContactSystem &sys, const Vector *extra_dv)
     // A contact that bounces keeps its approach speed until the step in which it closes:
     // SPOOK alone would brake it a step early (b > 0 asks for more than free flight).
     const double vn = Gv.size() ? Gv[row] - wall[0] : 0.0; // relative normal velocity
+    const double vn_free = ups_c * vn - b[row];            // the same after free flight
     const bool bounces = k.restitution > 0 && -vn > p.bounce_speed;
-    if (bounces && k.gap + p.h * vn <= 0) {
+    if (bounces && k.gap + p.h * vn_free <= 0) {
       // The compliance would keep Sigma / (w + Sigma) of the jump, w = 1/m_a + 1/m_b the
       // row's G M^-1 G^T: ask for that much more (exact for an isolated contact).
       const double w_nn =
-          1.0 / sys.bodies()[k.a].mass + (k.is_wall() ? 0.0 : 1.0 / sys.bodies()[k.b].mass);
+          sys.inv_mass()[kBodyDofs * k.a] + (k.is_wall() ? 0.0 : sys.inv_mass()[kBodyDofs * k.b]);
       const double jump = (b[row] - (ups_c + k.restitution) * vn) * (1.0 + sys.sigma()[row] / w_nn);
       b[row] = std::max(b_spook, jump);
     } else if (bounces && k.gap > 0) {
-      b[row] = std::min(b_spook, 0.0);
+      // Free flight, but not through the contact within the step when other contacts stop
+      // the partner: G_n v+ >= -gap / h.
+      b[row] = std::max(std::min(b_spook, 0.0), -k.gap / p.h - vn_free);
     } else {
       b[row] = b_spook;
     }
@@ -87,6 +94,45 @@ Vector velocity_change(const ContactSystem &sys, const Exchange &ex, const Vecto
   dv.array() *= sys.inv_mass().array();
   ex.forward(dv);
   return dv;
+}
+
+std::vector<std::array<double, kMaxRows>> advance_springs(const ContactSystem &sys,
+                                                          const Exchange &ex, const Vector &lambda)
+{
+  const int rows = sys.rows(), nc = sys.num_contacts();
+  std::vector<std::array<double, kMaxRows>> springs(nc);
+  Vector v_plus = body_velocities(sys) + external_velocity_change(sys);
+  if (lambda.size() == sys.contact_dofs()) v_plus += velocity_change(sys, ex, lambda);
+  Vector Gv;
+  g_apply(sys, v_plus, Gv);
+  const Cones cones(sys);
+  const double h = sys.params().h;
+  for (int c = 0; c < nc; ++c) {
+    const Contact &k = sys.contacts()[c];
+    if (!k.any_elastic()) continue;
+    const Eigen::Index base = Eigen::Index(rows) * c;
+    const std::array<double, kMaxRows> wall = wall_rows(k);
+    const double lambda_n = lambda.size() == sys.contact_dofs() ? std::max(lambda[base], 0.0) : 0.0;
+    for (int cone = 0; cone < num_cones(rows); ++cone) {
+      const Cone &rows_of = kCones[cone];
+      if (!k.elastic[rows_of.first]) continue;
+      Eigen::Vector2d xi = Eigen::Vector2d::Zero(), l = Eigen::Vector2d::Zero();
+      for (int i = 0; i < rows_of.size; ++i) {
+        const int r = rows_of.first + i;
+        xi[i] = k.spring[r] + h * (Gv[base + r] - wall[r]);
+        if (lambda.size() == sys.contact_dofs()) l[i] = lambda[base + r];
+      }
+      // the spring force |xi| / eps may not exceed the cone's radius per unit time
+      const double eps = k.compliance[rows_of.first];
+      const double limit = eps * cones.coeff(c, cone) * lambda_n / h;
+      if (xi.norm() > limit) {
+        const double ln = l.norm();
+        xi = ln > 0 ? Eigen::Vector2d(-limit / ln * l) : Eigen::Vector2d(limit / xi.norm() * xi);
+      }
+      for (int i = 0; i < rows_of.size; ++i) springs[c][rows_of.first + i] = xi[i];
+    }
+  }
+  return springs;
 }
 
 } // namespace fibre

@@ -20,7 +20,9 @@ constexpr int kBodyFields = 17;
 constexpr int kContactFieldsV1 = 2 + 12 + 1 + kMaxRows;
 constexpr int kContactFieldsV2 = kContactFieldsV1 + 3; // + mu, mu_roll, mu_twist
 // version 3: + restitution, damping, wall velocity (3) and angular velocity (3)
-constexpr int kContactFields = kContactFieldsV2 + 8;
+constexpr int kContactFieldsV3 = kContactFieldsV2 + 8;
+// version 4: + the elastic rows (a bit per row 1..5) and their springs (rows 1..5)
+constexpr int kContactFields = kContactFieldsV3 + kMaxRows;
 // Unit vectors must read back as unit vectors; exported data are far more exact than this.
 constexpr double kUnitTol = 1e-6;
 
@@ -229,6 +231,13 @@ void write_system(std::ostream &out, const ContactSystem &sys)
       put_real(s, f);
     }
     for (const Vec3 *v : {&c.wall_v, &c.wall_omega}) put_vec(s, *v);
+    int elastic = 0;
+    for (int r = 1; r < kMaxRows; ++r) elastic |= c.elastic[r] ? 1 << (r - 1) : 0;
+    s += ' ' + std::to_string(elastic);
+    for (int r = 1; r < kMaxRows; ++r) {
+      s += ' ';
+      put_real(s, c.spring[r]);
+    }
     s += '\n';
     out << s;
   }
@@ -268,6 +277,7 @@ ContactSystem parse_system(std::string_view text)
             std::to_string(kSystemFormatVersion) + ")");
   const int contact_fields = version == 1   ? kContactFieldsV1
                              : version == 2 ? kContactFieldsV2
+                             : version == 3 ? kContactFieldsV3
                                             : kContactFields;
 
   in.keyword(t, "rows", 1, "rows <3|6>");
@@ -370,6 +380,16 @@ ContactSystem parse_system(std::string_view text)
     k.wall_omega = read_vec(in, t, kContactFieldsV2 + 5, what + " wall angular velocity");
     if (!k.is_wall() && (k.wall_v != Vec3::Zero() || k.wall_omega != Vec3::Zero()))
       in.fail(what + ": a pair cannot have a wall velocity");
+    if (version == 3) continue;
+    const long long elastic = in.integer(t[kContactFieldsV3], what + " elastic rows");
+    if (elastic < 0 || elastic >= (1 << (kMaxRows - 1)))
+      in.fail(what + ": elastic rows must be a bit mask of rows 1 to 5, in [0, 31]");
+    for (int r = 1; r < kMaxRows; ++r) {
+      k.elastic[r] = (elastic >> (r - 1)) & 1;
+      k.spring[r] = in.real(t[kContactFieldsV3 + r], what + " spring");
+      if (!k.elastic[r] && k.spring[r] != 0)
+        in.fail(what + ": a spring on row " + std::to_string(r) + ", which is not elastic");
+    }
   }
 
   const long long dofs = rows * nc;

@@ -135,10 +135,10 @@ def main():
             ncont = [int(line.split()[1]) for line in sys_lines if line.startswith("contacts")]
             exported = {(int(w[1]), int(w[2])): float(w[4]) for w in lam}
             err = max(e2e.rel_err(exported[(int(r[0]), int(r[1]))], r[4]) for r in contacts)
-            # format version 2 (friction per contact); each line: index, tags, wall, the
+            # format version 4; each line: index, tags, wall, the
             # impulses and the warm start of every row
             rows = [int(line.split()[1]) for line in sys_lines if line.startswith("rows")]
-            ck.check(sys_lines[0] == "fibre_contact_system 3" and ncont == [len(contacts)]
+            ck.check(sys_lines[0] == "fibre_contact_system 4" and ncont == [len(contacts)]
                      and len(lam) == len(contacts) and err < 1e-12
                      and all(len(w) == 4 + 2 * rows[0] for w in lam),
                      "%s: export writes the system and the same impulses" % tag,

@@ -13,12 +13,15 @@ Taking over a native equilibrium (item 5a): native LAMMPS settles 48 Hertz spher
 (hertz/material E 1e5, Mindlin, rolling sds, Tsuji damping; overlaps of a few % of a diameter)
 on a floor and writes them with write_data; fix fibre_contact with `compliance material`
 continues them at 10 times the native step for 1 s. The secant Hertz compliance at each
-contact's load makes the native overlaps an equilibrium. The reference is native LAMMPS itself
-continuing from the same data file, which loses its tangential and rolling spring history in
-write_data and moves by about 1% of a diameter before it rests again. Checked: the pile comes
-to rest, and its largest move is within 3 times native's (measured 2.0% against 1.2%; the
-issue's target, 1%, is missed by that); with the rigid `compliance auto` the same pile moves by
-diameters (the overlaps close at the recovery speed), so the compliance is what holds it.
+contact's load makes the native overlaps an equilibrium, and the Mindlin and SDS springs (with
+their displacement carried from step to step) hold it as native's springs do. The reference is
+native LAMMPS itself continuing from the same data file, which loses its tangential and rolling
+spring history in write_data and moves by about 1.2% of a diameter before it rests again. Both
+start with relaxed springs. Checked: the pile comes to rest, and its largest move is below the
+issue's target, 1% of a diameter (measured 0.86%; 2.0% with rigid-plastic tangential and rolling
+rows, 3.8% with springs whose ghosts' velocity change was missing); with the rigid `compliance
+auto` the same pile moves by diameters (the overlaps close at the recovery speed), so the
+compliance is what holds it.
 Serial and on two processes.
 """
 
@@ -149,9 +152,10 @@ def native_equilibrium(args, ck):
         moved = max(runs["compliance material"].column("c_dmax"))
         rigid = max(runs["compliance auto"].column("c_dmax"))
         deepest = runs["compliance material"].column("f_fc[7]")[1]
-        ck.check(moved < 3 * native_moved,
+        ck.check(moved < 0.01 and moved < 1.5 * native_moved,
                  "np%d: compliance material keeps the native pile: its largest move in 1 s is "
-                 "within 3 times native LAMMPS's own from the same data file" % np,
+                 "below 1%% of a diameter, and not more than native LAMMPS's own from the same "
+                 "data file (within 50%%)" % np,
                  "%.3g against native %.3g diameters (overlaps up to %.3g)"
                  % (moved, native_moved, deepest))
         ke = runs["compliance material"].last("KinEng")

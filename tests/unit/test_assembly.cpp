@@ -101,7 +101,7 @@ TEST(Assembly, RhsMatchesFormulaAndMatrixFreeRhs)
 // A moving wall is body b with a prescribed velocity: the rhs of a system whose walls move
 // equals that of the same contacts against a real body b moving so (infinitely heavy, so
 // that its own external forces do not enter), and per-contact damping agrees between the
-// assembled and the matrix-free rhs.
+// assembled and the matrix-free rhs, and so do the elastic rows' springs.
 TEST(Assembly, MovingWallsAndPerContactDamping)
 {
   SceneParams p;
@@ -111,6 +111,10 @@ TEST(Assembly, MovingWallsAndPerContactDamping)
   int walls = 0;
   for (Contact &c : contacts) {
     c.damping = (c.a % 3 == 0) ? 7.5 : -1.0;
+    if (c.a % 2 == 0) { // elastic rows with their springs
+      c.elastic = {false, true, true, true, true, true};
+      c.spring = {0.0, 1e-4, -2e-4, 0.01, 0.02, -0.03};
+    }
     if (!c.is_wall()) continue;
     ++walls;
     c.wall_v = Vec3(0.3, -0.2, 0.1);

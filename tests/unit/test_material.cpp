@@ -131,23 +131,67 @@ TEST(Material, SecantComplianceOfTheNormalLaw)
   const double r_eff = 0.25, load = 3.0;
   const std::array<double, kMaxRows> rigid = {1e-9, 2e-9, 2e-9, 3e-9, 4e-9, 4e-9};
   std::array<double, kMaxRows> eps{};
+  std::array<bool, kMaxRows> elastic{};
   // loaded by the last step: eps F is Hertz's overlap at F, whatever the overlap now
-  ASSERT_TRUE(material_compliance(p, r_eff, 0.0, load, rigid, eps));
+  ASSERT_TRUE(material_compliance(p, r_eff, 0.0, load, rigid, eps, elastic));
   const double hertz = std::pow(load / (p.k_n * std::sqrt(r_eff)), 2.0 / 3.0);
   EXPECT_NEAR(eps[0] * load, hertz, 1e-14);
-  for (int r = 1; r < kMaxRows; ++r) EXPECT_EQ(eps[r], rigid[r]); // no displacement history
+  for (int r = 0; r < kMaxRows; ++r) EXPECT_FALSE(elastic[r]);
+  for (int r = 1; r < kMaxRows; ++r) EXPECT_EQ(eps[r], rigid[r]); // no springs in the law
   // a native state: no last force, the overlap's own Hertz force is the reference
-  ASSERT_TRUE(material_compliance(p, r_eff, hertz, 0.0, rigid, eps));
+  ASSERT_TRUE(material_compliance(p, r_eff, hertz, 0.0, rigid, eps, elastic));
   EXPECT_NEAR(eps[0] * load, hertz, 1e-12);
   // unloaded and not overlapping: rigid; Hooke: 1/k_n at any load; no law: rigid
-  material_compliance(p, r_eff, 0.0, 0.0, rigid, eps);
+  material_compliance(p, r_eff, 0.0, 0.0, rigid, eps, elastic);
   EXPECT_EQ(eps[0], rigid[0]);
   p.normal = NormalLaw::hooke;
-  material_compliance(p, r_eff, 0.0, load, rigid, eps);
+  material_compliance(p, r_eff, 0.0, load, rigid, eps, elastic);
   EXPECT_DOUBLE_EQ(eps[0], 1.0 / p.k_n);
   p.normal = NormalLaw::none;
-  EXPECT_FALSE(material_compliance(p, r_eff, 0.0, load, rigid, eps));
+  EXPECT_FALSE(material_compliance(p, r_eff, 0.0, load, rigid, eps, elastic));
   EXPECT_EQ(eps[0], rigid[0]);
+}
+
+// The springs: Mindlin k_t a, SDS rolling k_roll r_eff^2 per angle, Marshall twisting
+// 0.5 k_t a^2 (k_t a), each at the contact radius a = sqrt(r_eff d) of the reference load's
+// overlap d; unloaded contacts stay rigid.
+TEST(Material, SpringsOfTheTangentialRollingAndTwistingLaws)
+{
+  PairCoefficients p;
+  p.set = true;
+  p.normal = NormalLaw::hertz_material;
+  p.k_n = 7.3e4;
+  p.tangential = TangentialLaw::mindlin;
+  p.k_t = 5.1e4;
+  p.k_roll = 120.0;
+  p.twist = TwistLaw::marshall;
+  const double r_eff = 0.25, load = 3.0;
+  const std::array<double, kMaxRows> rigid = {1e-9, 2e-9, 2e-9, 3e-9, 4e-9, 4e-9};
+  std::array<double, kMaxRows> eps{};
+  std::array<bool, kMaxRows> elastic{};
+  ASSERT_TRUE(material_compliance(p, r_eff, 0.0, load, rigid, eps, elastic));
+  const double d = std::pow(load / (p.k_n * std::sqrt(r_eff)), 2.0 / 3.0);
+  const double a = std::sqrt(r_eff * d), k_t = p.k_t * a;
+  EXPECT_FALSE(elastic[0]);
+  for (int r = 1; r < kMaxRows; ++r) EXPECT_TRUE(elastic[r]) << r;
+  EXPECT_NEAR(eps[1], 1.0 / k_t, 1e-12 / k_t);
+  EXPECT_EQ(eps[1], eps[2]);
+  EXPECT_NEAR(eps[3], 1.0 / (0.5 * k_t * a * a), 1e-12 / (0.5 * k_t * a * a));
+  EXPECT_NEAR(eps[4], 1.0 / (p.k_roll * r_eff * r_eff), 1e-14);
+  EXPECT_EQ(eps[4], eps[5]);
+  // linear tangential, sds twisting
+  p.tangential = TangentialLaw::linear;
+  p.twist = TwistLaw::sds;
+  p.k_twist = 3.0;
+  material_compliance(p, r_eff, 0.0, load, rigid, eps, elastic);
+  EXPECT_DOUBLE_EQ(eps[1], 1.0 / p.k_t);
+  EXPECT_DOUBLE_EQ(eps[3], 1.0 / 3.0);
+  // unloaded: every row rigid, none elastic
+  material_compliance(p, r_eff, 0.0, 0.0, rigid, eps, elastic);
+  for (int r = 0; r < kMaxRows; ++r) {
+    EXPECT_FALSE(elastic[r]);
+    EXPECT_EQ(eps[r], rigid[r]);
+  }
 }
 
 // Unlike hertz/material types mix by the harmonic mean of the stored 4/3 E_eff (LAMMPS mixes E

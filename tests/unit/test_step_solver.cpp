@@ -195,6 +195,50 @@ TEST(ContactSolver, PulledSphereSticksOrSlides)
   }
 }
 
+// An elastic tangential row (compliance material's Mindlin or linear spring) with its
+// displacement carried from step to step: a sphere pulled below the friction limit settles
+// where the spring carries the pull (xi = F eps_t), springs back to where it started when the
+// pull stops, and pulled above the limit slides with the spring capped at mu F_n eps_t.
+TEST(ContactSolver, ElasticTangentialRowIsASpringUpToTheCone)
+{
+  const double m = 1.5, r = 0.4, mu = 0.5;
+  const double k_t = m * std::pow(2.0 * M_PI / (20.0 * kH), 2); // a period of 20 steps
+  std::vector<Body> bodies{sphere(m, r, Vec3(0, 0, r))};
+  Contact contact = sphere_wall_contact(bodies, 0, Vec3::UnitZ(), r);
+  contact.compliance.fill(1e-14);
+  contact.compliance[1] = contact.compliance[2] = 1.0 / k_t;
+  contact.elastic[1] = contact.elastic[2] = true;
+  contact.friction = FrictionParams{mu, 10.0, 0.0}; // rolling held
+  StepOptions o = base_options();
+  o.stop.tol = 1e-10;
+  double x = 0.0; // the sphere's travel
+  // n steps under a pull of `pull` m g along t1 = x
+  const auto run = [&](double pull, int n) {
+    for (int s = 0; s < n; ++s) {
+      bodies[0].force.x() = pull * m * kG;
+      ContactSystem sys(bodies, {contact}, 6, spook());
+      const StepResult res = solve(sys, o);
+      ASSERT_TRUE(res.converged);
+      contact.spring = advance_springs(sys, serial_exchange(), res.lambda)[0];
+      bodies[0].v += kH * bodies[0].force / m + res.dv.head<3>();
+      bodies[0].omega += res.dv.segment<3>(3);
+      x += kH * bodies[0].v.x();
+    }
+  };
+  run(0.3, 1000);
+  const double held = 0.3 * m * kG / k_t;
+  EXPECT_NEAR(contact.spring[1], held, 1e-6 * held);
+  EXPECT_NEAR(x, held, 1e-3 * held); // the sphere moved by the spring's stretch
+  EXPECT_NEAR(bodies[0].v.x(), 0.0, 1e-6 * kG * kH);
+  run(0.0, 1000);
+  EXPECT_NEAR(contact.spring[1], 0.0, 1e-6 * held); // back where it started
+  EXPECT_NEAR(x, 0.0, 1e-3 * held);
+  run(0.8, 200);
+  const double limit = mu * m * kG / k_t;
+  EXPECT_NEAR(contact.spring[1], limit, 1e-6 * limit);
+  EXPECT_NEAR(bodies[0].v.x(), 0.3 * kG * (200 - 1) * kH, 0.02 * 0.3 * kG * 200 * kH);
+}
+
 // Two spheres flying apart with a positive gap are released; approaching ones are not.
 TEST(ContactSolver, SeparatingPairIsReleased)
 {

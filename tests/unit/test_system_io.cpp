@@ -33,8 +33,10 @@ ContactSystem sample_system(int rows = 6)
   bodies[1].torque = Vec3(1e300, -1.0 / 7.0, 3.0);
   std::vector<Contact> contacts = pile.contacts();
   contacts[0].compliance = {1e-8, 2e-8, 3e-8, 4e-8, 5e-8, 6e-8};
-  contacts[1].friction = FrictionParams{0.3, 1.0 / 3.0, 0.0}; // per contact since version 2
-  contacts[1].restitution = 0.7;                              // since version 3
+  contacts[1].friction = FrictionParams{0.3, 1.0 / 3.0, 0.0};   // per contact since version 2
+  contacts[1].restitution = 0.7;                                // since version 3
+  contacts[2].elastic = {false, true, true, false, true, true}; // since version 4
+  contacts[2].spring = {0.0, 1.0 / 3.0, -2e-7, 0.0, 1e-300, -0.5};
   ContactSystem sys(bodies, contacts, rows, p.spook, pile.num_bodies() - 4);
   std::vector<unsigned char> mask(sys.contact_dofs(), 1);
   for (std::size_t r = 2; r < mask.size(); r += 7) mask[r] = 0;
@@ -81,7 +83,8 @@ void expect_identical(const ContactSystem &a, const ContactSystem &b)
                 p.compliance == q.compliance && p.friction.mu == q.friction.mu &&
                 p.friction.mu_roll == q.friction.mu_roll &&
                 p.friction.mu_twist == q.friction.mu_twist && p.restitution == q.restitution &&
-                p.damping == q.damping && p.wall_v == q.wall_v && p.wall_omega == q.wall_omega)
+                p.damping == q.damping && p.wall_v == q.wall_v && p.wall_omega == q.wall_omega &&
+                p.elastic == q.elastic && p.spring == q.spring)
         << "contact " << c;
   }
   EXPECT_EQ(a.row_mask(), b.row_mask());
@@ -152,7 +155,7 @@ TEST(SystemIo, RoundTripIsExact)
   for (int rows : {6, 3}) {
     const ContactSystem sys = sample_system(rows);
     const std::string text = to_text(sys);
-    EXPECT_EQ(text.rfind("fibre_contact_system 3\n", 0), 0u);
+    EXPECT_EQ(text.rfind("fibre_contact_system 4\n", 0), 0u);
     const ContactSystem back = parse_system(text);
     expect_identical(sys, back);
     EXPECT_EQ(to_text(back), text); // and the writer is deterministic
@@ -182,7 +185,7 @@ std::string older_version(const ContactSystem &sys, int version, int drop_spook,
     }
     out += line + "\n";
   }
-  out.replace(0, std::string("fibre_contact_system 3").size(),
+  out.replace(0, std::string("fibre_contact_system 4").size(),
               "fibre_contact_system " + std::to_string(version));
   return out;
 }
@@ -192,18 +195,22 @@ std::string older_version(const ContactSystem &sys, int version, int drop_spook,
 TEST(SystemIo, OlderVersionsAndCoefficientFields)
 {
   const ContactSystem sys = sample_system();
-  const ContactSystem v1 = parse_system(older_version(sys, 1, 2, 11));
+  const ContactSystem v1 = parse_system(older_version(sys, 1, 2, 17));
   ASSERT_EQ(v1.num_contacts(), sys.num_contacts());
   EXPECT_EQ(v1.contacts()[1].friction.mu, FrictionParams{}.mu);
   EXPECT_EQ(v1.contacts()[1].friction.mu_roll, FrictionParams{}.mu_roll);
   EXPECT_EQ(v1.contacts()[1].restitution, 0.0);
   EXPECT_EQ(v1.contacts()[0].compliance, sys.contacts()[0].compliance);
   EXPECT_EQ(v1.params().max_recovery, 0.0);
-  const ContactSystem v2 = parse_system(older_version(sys, 2, 1, 8));
+  const ContactSystem v2 = parse_system(older_version(sys, 2, 1, 14));
   EXPECT_EQ(v2.contacts()[1].friction.mu, 0.3);
   EXPECT_EQ(v2.contacts()[1].restitution, 0.0);
   EXPECT_EQ(v2.params().max_recovery, 0.125);
   EXPECT_EQ(v2.params().bounce_speed, 0.0);
+  const ContactSystem v3 = parse_system(older_version(sys, 3, 0, 6));
+  EXPECT_EQ(v3.contacts()[1].restitution, 0.7);
+  EXPECT_FALSE(v3.contacts()[2].any_elastic());
+  EXPECT_EQ(v3.contacts()[2].spring, (std::array<double, kMaxRows>{}));
   // the first contact line with a negative twisting coefficient, a restitution of 2 and a
   // negative damping other than -1
   const std::string text = to_text(sys);
@@ -212,7 +219,7 @@ TEST(SystemIo, OlderVersionsAndCoefficientFields)
   std::vector<std::string> fields;
   std::istringstream words(text.substr(begin, end - begin));
   for (std::string w; words >> w;) fields.push_back(w);
-  ASSERT_EQ(fields.size(), 32u);
+  ASSERT_EQ(fields.size(), 38u);
   const auto with = [&](std::size_t index, const std::string &value) {
     std::vector<std::string> f = fields;
     f[index] = value;
@@ -224,6 +231,10 @@ TEST(SystemIo, OlderVersionsAndCoefficientFields)
   expect_error(with(24, "2"), {"contact 0:", "restitution must be in [0, 1]"});
   expect_error(with(25, "-2"), {"contact 0:", "damping must be non-negative"});
   EXPECT_EQ(parse_system(with(25, "-1")).contacts()[0].damping, -1.0);
+  expect_error(with(32, "32"), {"contact 0:", "elastic rows must be a bit mask"});
+  expect_error(with(33, "0.5"), {"contact 0:", "a spring on row 1, which is not elastic"});
+  const Contact elastic = parse_system(with(32, "9")).contacts()[0]; // rows 1 and 4
+  EXPECT_TRUE(elastic.elastic[1] && elastic.elastic[4] && !elastic.elastic[2]);
   if (sys.contacts()[0].is_wall()) return;
   expect_error(with(26, "1"), {"contact 0:", "a pair cannot have a wall velocity"});
 }
@@ -271,7 +282,7 @@ TEST(SystemIo, EachMalformedInputGetsItsOwnError)
 
   expect_error("", {"line 1:", "unexpected end of input", "header"});
   expect_error(edit(0, "fibre_contact_sistem 1"), {"line 1:", "not a fibre_contact system"});
-  expect_error(edit(0, "fibre_contact_system 4"), {"unsupported format version 4"});
+  expect_error(edit(0, "fibre_contact_system 5"), {"unsupported format version 5"});
   expect_error(edit(0, "fibre_contact_system one"), {"'one' is not an integer"});
   expect_error(edit(2, "rows 4"), {"rows must be 3 or 6"});
   expect_error(edit(3, "spook 0 2"), {"time step h must be positive"});
@@ -289,7 +300,7 @@ TEST(SystemIo, EachMalformedInputGetsItsOwnError)
     const std::string cut = join(std::vector<std::string>(L.begin(), L.begin() + last)) +
                             L[last].substr(0, L[last].size() / 2);
     expect_error(cut, {line_tag(last), "contact " + std::to_string(sys.num_contacts() - 1) +
-                                           ": expected 32 values"});
+                                           ": expected 38 values"});
     expect_error(text.substr(0, text.size() - 4), {"unexpected end of input", "'end'"});
     std::vector<std::string> early(L.begin(), L.begin() + bodies + 3);
     expect_error(join(early), {line_tag(bodies), "body count 25 is more than the rest"});
@@ -332,7 +343,7 @@ TEST(SystemIo, EachMalformedInputGetsItsOwnError)
   expect_error(edit(contacts + 1, with_token(c0, 2, "2")), {"contact 0 normal is not a unit"});
   expect_error(edit(contacts + 1, with_token(c0, 15, "0")),
                {"contact 0: compliance of row 0 must be positive"});
-  expect_error(edit(contacts + 1, c0 + " 7"), {"contact 0: expected 32 values, found 33"});
+  expect_error(edit(contacts + 1, c0 + " 7"), {"contact 0: expected 38 values, found 39"});
 
   // Anything after the end, and binary junk.
   expect_error(text + "bodies 1 1\n", {"unexpected content after 'end'"});

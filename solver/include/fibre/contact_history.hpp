@@ -1,9 +1,11 @@
-// Warm-start history per atom, without a front end: every atom keeps up to kMaxSlots of its
-// contacts as (key, force, torque) of the last step, in the world frame, so that they survive
-// the contact frame's rotation, atom migration and restart files. The front end calls grow,
-// copy, clear, pack and unpack from its per-atom callbacks.
+// Contact history per atom, without a front end: every atom keeps up to kMaxSlots of its
+// contacts as (key, force, torque, springs) of the last step, in the world frame, so that they
+// survive the contact frame's rotation, atom migration and restart files. The force and torque
+// warm-start the solve; the springs are the elastic rows' displacements (Contact::spring).
+// The front end calls grow, copy, clear, pack and unpack from its per-atom callbacks.
 #pragma once
 
+#include <array>
 #include <vector>
 
 #include "fibre/detection.hpp"
@@ -15,8 +17,9 @@ class ContactHistory {
  public:
   static constexpr int kMaxSlots = 16;
   // key (the other side's tag, or a wall key), then force and torque (impulse / h) acting on
-  // the contact's body a.
-  static constexpr int kSlotSize = 7;
+  // the contact's body a, then the tangential displacement (3), the rolling angle (3) and the
+  // twisting angle (1).
+  static constexpr int kSlotSize = 14;
   static constexpr int kMaxPacked = 1 + kMaxSlots * kSlotSize;
 
   void grow(int nmax); // room for atoms [0, nmax); new atoms have no contacts
@@ -27,17 +30,26 @@ class ContactHistory {
   // buf <- [n, n slots]; returns the number of values written (packed_size).
   int pack(int i, double *buf) const;
   // Atom i <- [n, slots] from buf, trusting at most `available` values after n; returns the
-  // number of values read.
-  int unpack(int i, const double *buf, int available = kMaxSlots * kSlotSize);
+  // number of values read. slot_size: the writer's (kWarmStartSlot: files without springs,
+  // which read back with zero springs).
+  static constexpr int kWarmStartSlot = 7;
+  int unpack(int i, const double *buf, int available = kMaxSlots * kSlotSize,
+             int slot_size = kSlotSize);
   double memory_bytes() const;
 
   // The step's warm start, rows per contact: lambda_r = h (F . d_r) with the stored force and
   // torque and this step's frame (zero for contacts not stored).
   Vector warm_start(const std::vector<DetectedContact> &found, int rows, double h) const;
-  // Replaces every stored contact of atoms [0, nlocal) by this step's pressing contacts.
+  // Contact::spring of every stored contact in this step's frame: the stored tangential and
+  // rolling vectors turned into the new tangent plane with their length kept (LAMMPS's rule),
+  // the twisting angle as it is. `contacts` are the found ones, in their order.
+  void load_springs(const std::vector<DetectedContact> &found,
+                    std::vector<Contact> &contacts) const;
+  // Replaces every stored contact of atoms [0, nlocal) by this step's pressing contacts, with
+  // their springs at the step's end (advance_springs, rows per contact; null: none).
   // Returns how many did not fit (more than kMaxSlots on one atom).
   long store(const std::vector<DetectedContact> &found, const Vector &lambda, int rows, double h,
-             int nlocal);
+             int nlocal, const std::vector<std::array<double, kMaxRows>> *springs = nullptr);
 
  private:
   const double *find(int atom, double key) const;

@@ -61,6 +61,8 @@ struct ContactModel {
   TypedCoefficients typed{};
   MaterialTable materials; // empty: the pair style gave none (or coefficients fix)
   bool per_type() const { return coefficients == CoefficientSource::pair && !materials.empty(); }
+  // Whether any contact can have a restitution above 0 (the keyword or a type pair's).
+  bool may_bounce() const;
 };
 
 // The automatic bounce speed's scale: max over bodies of h |f| / m (local; a front end takes

@@ -56,7 +56,9 @@ struct WallSpec {
 // step: SPOOK then brakes the approach before the spheres overlap. b == nullptr: a wall or a
 // fixed obstacle. n points from b (the wall) to a. A contact with a positive gap never pulls:
 // its impulse would be negative and the solve releases it.
-bool is_contact(const Body &a, const Body *b, const Vec3 &n, double gap, double h, double damping);
+// kick: a speed the bodies may gain within the step from impacts (any direction).
+bool is_contact(const Body &a, const Body *b, const Vec3 &n, double gap, double h, double damping,
+                double kick = 0.0);
 
 // How far from a sphere a region wall is looked for: its radius, the margin, and its
 // free-flight reach over (damping + 1) steps, capped at the neighbour skin.

@@ -73,15 +73,16 @@ double restitution_from_tsuji(double alpha);
 // mu_twist per unit r_eff as FrictionParams keeps it.
 FrictionParams contact_friction(const PairCoefficients &p, double r_eff, double overlap);
 
-// `compliance material` (doc/design.md section 2, "Material"): the normal row's secant
-// compliance of the normal law at the reference load F = max(the contact's last normal force,
-// the law's force at its overlap), so that a contact at rest under a steady load overlaps by
-// the law's d(F), and a native state at equilibrium is one here too. The other rows, and a
-// contact with F = 0 (new, not overlapping), keep `rigid` (the automatic compliance): they have
-// no displacement in the rhs, so a compliance there would be a viscosity (creep under a steady
-// load), not the law's spring. Returns false when p has no normal law.
+// `compliance material` (doc/design.md section 2, "Material"): the rows' compliances from the
+// pair's elastic laws at the reference load F = max(the contact's last normal force, the law's
+// force at its overlap). Normal row: the secant compliance d(F) / F, so that a contact at rest
+// under a steady load overlaps by the law's d(F) and a native state at equilibrium is one here
+// too. Tangential, twisting and rolling rows: 1 / the law's spring at the contact radius a of
+// d(F), marked `elastic` (they carry their displacement in the rhs, Contact::spring). Rows
+// without a spring, and every row of a contact with F = 0 (new, not overlapping), keep `rigid`
+// (the automatic compliance). Returns false when p has no normal law.
 bool material_compliance(const PairCoefficients &p, double r_eff, double overlap, double last_force,
                          const std::array<double, kMaxRows> &rigid,
-                         std::array<double, kMaxRows> &eps);
+                         std::array<double, kMaxRows> &eps, std::array<bool, kMaxRows> &elastic);
 
 } // namespace fibre

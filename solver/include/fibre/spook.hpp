@@ -2,6 +2,9 @@
 // the step's velocities and external forces, and the velocity change of given impulses.
 #pragma once
 
+#include <array>
+#include <vector>
+
 #include "fibre/exchange.hpp"
 #include "fibre/system.hpp"
 
@@ -12,7 +15,8 @@ Vector body_velocities(const ContactSystem &sys);
 // h M^-1 f_ext per body (the free-flight velocity change).
 Vector external_velocity_change(const ContactSystem &sys);
 
-// b = -(4/h) Upsilon g - (1 - Upsilon) G v - G (h M^-1 f_ext + extra_dv).
+// b = -(4/h) Upsilon g - (1 - Upsilon) G v - G (h M^-1 f_ext + extra_dv), g the gap on normal
+// rows and the spring's displacement on elastic rows.
 // extra_dv (optional, 6 per body) is a velocity change from impulses held fixed outside the
 // solve (capped friction rows); it must be complete on ghosts as well.
 Vector spook_rhs(const ContactSystem &sys, const Vector *extra_dv = nullptr);
@@ -20,5 +24,14 @@ Vector spook_rhs(const ContactSystem &sys, const Vector *extra_dv = nullptr);
 // The velocity change of impulses lambda: dv = M^-1 G^T lambda, summed over all processes and
 // complete on owned bodies and ghosts. The one place this product is written.
 Vector velocity_change(const ContactSystem &sys, const Exchange &ex, const Vector &lambda);
+
+// The elastic rows' displacements at the step's end, rows per contact in each contact's frame
+// (Contact::spring): spring + h G v+ on every elastic row, with v+ = v + h M^-1 f + M^-1 G^T
+// lambda the velocities after the step, ghosts included. On a cone at its limit the spring
+// keeps only the displacement whose force the cone carries, -eps lambda / h (LAMMPS's history
+// rescaling), so that a sliding contact snaps back by its elastic part only. Zero on rows that
+// are not elastic. Collective (velocity_change): every process calls it.
+std::vector<std::array<double, kMaxRows>> advance_springs(const ContactSystem &sys,
+                                                          const Exchange &ex, const Vector &lambda);
 
 } // namespace fibre

@@ -65,6 +65,19 @@ struct Contact {
   // (zero for walls at rest). They enter the rhs as the velocity of body b (spook_rhs).
   Vec3 wall_v = Vec3::Zero();
   Vec3 wall_omega = Vec3::Zero();
+  // Elastic rows (compliance material): a row whose compliance is the law's spring carries
+  // its displacement at the step's start, in the contact frame, in the rhs as the normal row
+  // carries the gap: rows 1, 2 the tangential displacement (length), 3 the twisting and 4, 5
+  // the rolling angle. Row 0 is never elastic here (its displacement is the gap). Without the
+  // displacement a compliance would be a viscosity.
+  std::array<bool, kMaxRows> elastic{};
+  std::array<double, kMaxRows> spring{};
+  bool any_elastic() const
+  {
+    for (bool e : elastic)
+      if (e) return true;
+    return false;
+  }
   bool is_wall() const { return b < 0; }
   bool wall_moves() const
   {
@@ -116,6 +129,11 @@ struct SpookParams {
     return max_recovery > 0 && term > max_recovery ? max_recovery : term;
   }
   double gap_term(double gap) const { return gap_term(gap, upsilon()); }
+  // The same term of an elastic row's displacement, unbounded (the cone bounds the spring).
+  double spring_term(double displacement, double ups) const
+  {
+    return -4.0 / h * ups * displacement;
+  }
   double upsilon(double d) const { return 1.0 / (1.0 + 4.0 * d); }
   double upsilon() const { return upsilon(damping); }
   // Sigma entry for compliance eps: 4 eps / (h^2 (1 + 4 d)).
