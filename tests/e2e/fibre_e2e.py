@@ -66,6 +66,17 @@ class Run:
         return ""
 
 
+def sphere_box(box, types=1, boundary="f f f", processors=None):
+    """The deck lines up to create_box for spheres: atom_style sphere with an atom map, newton
+    off, ghost velocities, a block box (the six bounds as a string) with `types` atom types,
+    and optionally a processor grid ("2 1 1")."""
+    lines = ["atom_style sphere", "atom_modify map array", "boundary " + boundary,
+             "newton off", "comm_modify vel yes"]
+    if processors:
+        lines.append("processors " + processors)
+    return lines + ["region box block %s units box" % box, "create_box %d box" % types]
+
+
 def run_lmp(args, deck, name, np=1, variables=None, timeout=600):
     """Writes `deck` to WORKDIR/in.NAME and runs it with np processes (mpirun if np > 1)."""
     deck_path = os.path.join(args.workdir, "in." + name)

@@ -25,15 +25,7 @@ DT = 0.01
 
 
 def header(box="-20 20 -20 20 -20 20"):
-    return [
-        "atom_style sphere",
-        "atom_modify map array",
-        "boundary f f f",
-        "newton off",
-        "comm_modify vel yes",
-        "region box block %s units box" % box,
-        "create_box 1 box",
-    ]
+    return e2e.sphere_box(box)
 
 
 def momentum_thermo(extra=""):

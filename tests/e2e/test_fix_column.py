@@ -28,15 +28,7 @@ STEPS = 1000
 
 
 def deck(opts):
-    lines = [
-        "atom_style sphere",
-        "atom_modify map array",
-        "boundary f f f",
-        "newton off",
-        "comm_modify vel yes",
-        "region box block -3 3 -3 3 0 10 units box",
-        "create_box 1 box",
-    ]
+    lines = e2e.sphere_box("-3 3 -3 3 0 10")
     z = 0.0
     for i, d in enumerate(DIAMETERS):
         lines.append("create_atoms 1 single 0 0 %.17g units box" % (z + d / 2))

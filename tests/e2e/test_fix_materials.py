@@ -31,11 +31,7 @@ pair_coeff 2 2 hertz/material 1e6 0.9 0.3 tangential mindlin NULL 1.0 0.8 rollin
 
 
 def deck(pair, gravity, atoms, fix_extra, np, steps):
-    lines = ["atom_style sphere", "atom_modify map array", "boundary f f f", "newton off",
-             "comm_modify vel yes"]
-    if np == 2:
-        lines.append("processors 2 1 1")
-    lines += ["region box block -10 10 -10 10 0 10 units box", "create_box 2 box"]
+    lines = e2e.sphere_box("-10 10 -10 10 0 10", types=2, processors="2 1 1" if np == 2 else None)
     for k, (t, x, z) in enumerate(atoms):
         lines += ["create_atoms %d single %g 0 %g units box" % (t, x, z),
                   "set atom %d diameter 1.0 density 1.0" % (k + 1)]

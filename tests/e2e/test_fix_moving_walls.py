@@ -26,11 +26,7 @@ DT = 1e-3
 
 
 def header(np, box):
-    lines = ["atom_style sphere", "atom_modify map array", "boundary f f f", "newton off",
-             "comm_modify vel yes"]
-    if np == 2:
-        lines.append("processors 2 1 1")
-    return lines + ["region box block %s units box" % box, "create_box 2 box"]
+    return e2e.sphere_box(box, types=2, processors="2 1 1" if np == 2 else None)
 
 
 def thermo(extra=""):

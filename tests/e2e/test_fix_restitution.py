@@ -18,15 +18,7 @@ H = 5.0  # drop height of the sphere's lowest point
 
 
 def header(box):
-    return [
-        "atom_style sphere",
-        "atom_modify map array",
-        "boundary f f f",
-        "newton off",
-        "comm_modify vel yes",
-        "region box block %s units box" % box,
-        "create_box 1 box",
-    ]
+    return e2e.sphere_box(box)
 
 
 def drop(args, ck, e, np, steps):

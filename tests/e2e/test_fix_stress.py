@@ -26,16 +26,7 @@ STEPS = 600
 
 
 def deck(np):
-    lines = [
-        "atom_style sphere",
-        "atom_modify map array",
-        "boundary f f f",
-        "newton off",
-        "comm_modify vel yes",
-    ]
-    if np == 2:
-        lines.append("processors 1 1 2")
-    lines += ["region box block -3 3 -3 3 0 12 units box", "create_box 1 box"]
+    lines = e2e.sphere_box("-3 3 -3 3 0 12", processors="1 1 2" if np == 2 else None)
     z = 0.0
     for i, d in enumerate(DIAMETERS):
         lines.append("create_atoms 1 single 0 0 %.17g units box" % (z + d / 2))
@@ -86,14 +77,8 @@ def column(args, ck, np):
 
 
 def bed_deck(np):
-    lines = ["atom_style sphere", "atom_modify map array", "boundary p p f", "newton off",
-             "comm_modify vel yes"]
-    if np == 2:
-        lines.append("processors 1 1 2")
-    lines += [
-        "region box block 0 5 0 5 0 12 units box",
-        "create_box 1 box",
-    ]
+    lines = e2e.sphere_box("0 5 0 5 0 12", boundary="p p f",
+                           processors="1 1 2" if np == 2 else None)
     # 5 layers of 4 x 4, 1.25 apart, each sphere shifted sideways by up to 0.12
     rng = random.Random(4821)
     for k in range(80):
