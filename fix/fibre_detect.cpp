@@ -132,9 +132,9 @@ LammpsDetection::contacts(const std::vector<fibre::Body> &bodies, double h, doub
     fibre::Vector kick = fibre::Vector::Zero(6 * Eigen::Index(nbody));
     for (const fibre::DetectedContact &fc : found) {
       const fibre::Contact &c = fc.contact;
-      fibre::Vec3 rel = bodies[c.a].v + (h / bodies[c.a].mass) * bodies[c.a].force - c.wall_v;
-      if (!c.is_wall()) rel -= bodies[c.b].v + (h / bodies[c.b].mass) * bodies[c.b].force;
-      const double approach = -c.normal.dot(rel);
+      const fibre::Body *b = c.is_wall() ? nullptr : &bodies[c.b];
+      const double approach =
+          fibre::free_approach(bodies[c.a], b, c.normal, h) + c.normal.dot(c.wall_v);
       if (!(approach > 0.0)) continue;
       kick[6 * c.a] = std::max(kick[6 * c.a], 2.0 * approach);
       if (!c.is_wall()) kick[6 * c.b] = std::max(kick[6 * c.b], 2.0 * approach);

@@ -6,15 +6,20 @@
 
 namespace fibre {
 
+double free_approach(const Body &a, const Body *b, const Vec3 &n, double h)
+{
+  Vec3 rel = a.v + (h / a.mass) * a.force;
+  if (b) rel -= b->v + (h / b->mass) * b->force;
+  return -n.dot(rel);
+}
+
 bool is_contact(const Body &a, const Body *b, const Vec3 &n, double gap, double h, double damping,
                 double kick)
 {
   const double rmin = b ? std::min(a.radius, b->radius) : a.radius;
   const double margin = kContactMargin * rmin + (damping + 1.0) * h * kick;
   if (gap < margin) return true;
-  Vec3 rel = a.v + (h / a.mass) * a.force;
-  if (b) rel -= b->v + (h / b->mass) * b->force;
-  const double approach = -n.dot(rel);
+  const double approach = free_approach(a, b, n, h);
   return approach > 0.0 && gap < margin + (damping + 1.0) * h * approach;
 }
 

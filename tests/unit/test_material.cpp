@@ -122,14 +122,26 @@ TEST(Material, ApplyContactModelPerType)
 }
 
 // compliance material: the secant compliance at the reference load gives the law's overlap.
-TEST(Material, SecantComplianceOfTheNormalLaw)
+namespace {
+
+// A hertz/material pair (k_n = 4/3 E_eff) and the automatic compliance it falls back to.
+PairCoefficients hertz_material_pair()
 {
   PairCoefficients p;
   p.set = true;
   p.normal = NormalLaw::hertz_material;
-  p.k_n = 7.3e4; // 4/3 E_eff
+  p.k_n = 7.3e4;
+  return p;
+}
+const std::array<double, kMaxRows> kRigid = {1e-9, 2e-9, 2e-9, 3e-9, 4e-9, 4e-9};
+
+} // namespace
+
+TEST(Material, SecantComplianceOfTheNormalLaw)
+{
+  PairCoefficients p = hertz_material_pair();
   const double r_eff = 0.25, load = 3.0;
-  const std::array<double, kMaxRows> rigid = {1e-9, 2e-9, 2e-9, 3e-9, 4e-9, 4e-9};
+  const std::array<double, kMaxRows> &rigid = kRigid;
   std::array<double, kMaxRows> eps{};
   std::array<bool, kMaxRows> elastic{};
   // loaded by the last step: eps F is Hertz's overlap at F, whatever the overlap now
@@ -157,16 +169,13 @@ TEST(Material, SecantComplianceOfTheNormalLaw)
 // overlap d; unloaded contacts stay rigid.
 TEST(Material, SpringsOfTheTangentialRollingAndTwistingLaws)
 {
-  PairCoefficients p;
-  p.set = true;
-  p.normal = NormalLaw::hertz_material;
-  p.k_n = 7.3e4;
+  PairCoefficients p = hertz_material_pair();
   p.tangential = TangentialLaw::mindlin;
   p.k_t = 5.1e4;
   p.k_roll = 120.0;
   p.twist = TwistLaw::marshall;
   const double r_eff = 0.25, load = 3.0;
-  const std::array<double, kMaxRows> rigid = {1e-9, 2e-9, 2e-9, 3e-9, 4e-9, 4e-9};
+  const std::array<double, kMaxRows> &rigid = kRigid;
   std::array<double, kMaxRows> eps{};
   std::array<bool, kMaxRows> elastic{};
   ASSERT_TRUE(material_compliance(p, r_eff, 0.0, load, rigid, eps, elastic));

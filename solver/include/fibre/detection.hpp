@@ -56,6 +56,9 @@ struct WallSpec {
 // step: SPOOK then brakes the approach before the spheres overlap. b == nullptr: a wall or a
 // fixed obstacle. n points from b (the wall) to a. A contact with a positive gap never pulls:
 // its impulse would be negative and the solve releases it.
+// How fast a approaches b (or a wall at rest, b == nullptr) along n after a step of free flight
+// under their external forces; negative when they separate. n points from b to a.
+double free_approach(const Body &a, const Body *b, const Vec3 &n, double h);
 // kick: a speed the bodies may gain within the step from impacts (any direction).
 bool is_contact(const Body &a, const Body *b, const Vec3 &n, double gap, double h, double damping,
                 double kick = 0.0);
