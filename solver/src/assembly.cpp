@@ -85,7 +85,7 @@ Vector assemble_rhs(const ContactSystem &sys)
     for (int r = 1; r < sys.rows(); ++r)
       if (k.elastic[r] && sys.row_active(row + r))
         rhs[row + r] += p.spring_term(k.spring[r], ups_c);
-    if (sys.row_active(row)) rhs[row] += p.gap_term(k.gap, ups_c);
+    if (sys.row_active(row)) rhs[row] += p.gap_term(k.gap, ups_c, k.elastic[0]);
   }
   return rhs;
 }

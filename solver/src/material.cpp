@@ -111,6 +111,7 @@ bool material_compliance(const PairCoefficients &p, double r_eff, double overlap
   // the law's overlap at the reference load, and its contact radius
   const double d = hertz ? std::cbrt(f * f / (p.k_n * p.k_n * r_eff)) : f / p.k_n;
   eps[0] = d / f;
+  elastic[0] = true; // the gap is the law's overlap at the load
   const double a = std::sqrt(r_eff * d);
   // the springs, each with its displacement in the rhs (Contact::spring)
   const double k_t = p.tangential == TangentialLaw::mindlin  ? p.k_t * a

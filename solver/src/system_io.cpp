@@ -22,6 +22,7 @@ constexpr int kContactFieldsV2 = kContactFieldsV1 + 3; // + mu, mu_roll, mu_twis
 // version 3: + restitution, damping, wall velocity (3) and angular velocity (3)
 constexpr int kContactFieldsV3 = kContactFieldsV2 + 8;
 // version 4: + the elastic rows (a bit per row 1..5) and their springs (rows 1..5)
+// version 5: the same, with bit 5 for an elastic normal row (the material's spring)
 constexpr int kContactFields = kContactFieldsV3 + kMaxRows;
 // Unit vectors must read back as unit vectors; exported data are far more exact than this.
 constexpr double kUnitTol = 1e-6;
@@ -231,7 +232,7 @@ void write_system(std::ostream &out, const ContactSystem &sys)
       put_real(s, f);
     }
     for (const Vec3 *v : {&c.wall_v, &c.wall_omega}) put_vec(s, *v);
-    int elastic = 0;
+    int elastic = c.elastic[0] ? 1 << (kMaxRows - 1) : 0;
     for (int r = 1; r < kMaxRows; ++r) elastic |= c.elastic[r] ? 1 << (r - 1) : 0;
     s += ' ' + std::to_string(elastic);
     for (int r = 1; r < kMaxRows; ++r) {
@@ -382,8 +383,12 @@ ContactSystem parse_system(std::string_view text)
       in.fail(what + ": a pair cannot have a wall velocity");
     if (version == 3) continue;
     const long long elastic = in.integer(t[kContactFieldsV3], what + " elastic rows");
-    if (elastic < 0 || elastic >= (1 << (kMaxRows - 1)))
+    if (version == 4 && (elastic < 0 || elastic >= (1 << (kMaxRows - 1))))
       in.fail(what + ": elastic rows must be a bit mask of rows 1 to 5, in [0, 31]");
+    if (elastic < 0 || elastic >= (1 << kMaxRows))
+      in.fail(what + ": elastic rows must be a bit mask of rows 1 to 5 and the normal row, in [0, "
+                     "63]");
+    k.elastic[0] = (elastic >> (kMaxRows - 1)) & 1;
     for (int r = 1; r < kMaxRows; ++r) {
       k.elastic[r] = (elastic >> (r - 1)) & 1;
       k.spring[r] = in.real(t[kContactFieldsV3 + r], what + " spring");

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <limits>
 
+#include "fibre/material.hpp"
 #include "fibre/spook.hpp"
 #include "fibre/step_solver.hpp"
 #include "fibre/kernels.hpp"
@@ -237,6 +238,57 @@ TEST(ContactSolver, ElasticTangentialRowIsASpringUpToTheCone)
   const double limit = mu * m * kG / k_t;
   EXPECT_NEAR(contact.spring[1], limit, 1e-6 * limit);
   EXPECT_NEAR(bodies[0].v.x(), 0.3 * kG * (200 - 1) * kH, 0.02 * 0.3 * kG * 200 * kH);
+}
+
+// max_recovery bounds the removal of a rigid row's overlap, not the force of a material one.
+// A sphere pressed 4x deeper into the floor than Hertz's overlap under its weight, with the
+// material's secant compliance (compliance material) and a recovery speed that would cap the
+// row's force below the weight (critically damped, as the fix damps it): it rises to Hertz's
+// overlap and rests there. A rigid row with
+// the same overlap is pushed out at the recovery speed, not faster.
+TEST(ContactSolver, RecoverySpeedBoundsRigidRowsNotTheMaterialsSpring)
+{
+  const double m = 0.2, r = 0.25, v_rec = 1e-3;
+  PairCoefficients law;
+  law.set = true;
+  law.normal = NormalLaw::hertz_material;
+  law.k_n = 5e4; // F = k_n sqrt(r d) d
+  const double weight = m * kG;
+  const double d_eq = std::cbrt(weight * weight / (law.k_n * law.k_n * r));
+  SpookParams params = spook();
+  params.max_recovery = v_rec;
+  StepOptions o = base_options();
+  o.stop.tol = 1e-10;
+  std::vector<Body> bodies{sphere(m, r, Vec3(0, 0, r - 4.0 * d_eq))};
+  double force = 0.0; // the last step's normal force
+  for (int s = 0; s < 400; ++s) {
+    Contact c = sphere_wall_contact(bodies, 0, Vec3::UnitZ(), bodies[0].x.z());
+    std::array<double, kMaxRows> rigid{};
+    rigid.fill(1e-12);
+    ASSERT_TRUE(material_compliance(law, r, -c.gap, force, rigid, c.compliance, c.elastic));
+    if (s == 0) ASSERT_TRUE(c.elastic[0]);
+    c.damping = std::max(2.0, 2.0 * std::sqrt(m * c.compliance[0]) / kH); // critical, as the fix
+    ContactSystem sys(bodies, {c}, 3, params);
+    const StepResult res = solve(sys, o);
+    ASSERT_TRUE(res.converged);
+    force = res.lambda[0] / kH;
+    bodies[0].v += kH * bodies[0].force / m + res.dv.head<3>();
+    bodies[0].x += kH * bodies[0].v;
+  }
+  EXPECT_NEAR(r - bodies[0].x.z(), d_eq, 1e-3 * d_eq);
+  EXPECT_NEAR(force, weight, 1e-3 * weight);
+  EXPECT_NEAR(bodies[0].v.z(), 0.0, 1e-6);
+  // rigid: the same overlap leaves at the recovery speed
+  bodies[0].x.z() = r - 4.0 * d_eq;
+  bodies[0].v.setZero();
+  Contact c = sphere_wall_contact(bodies, 0, Vec3::UnitZ(), bodies[0].x.z());
+  c.compliance.fill(1e-12);
+  ContactSystem rigid_sys(bodies, {c}, 3, params);
+  const StepResult res = solve(rigid_sys, o);
+  ASSERT_TRUE(res.converged);
+  const double vz = kH * bodies[0].force.z() / m + res.dv[2];
+  EXPECT_GT(vz, 0.5 * v_rec);
+  EXPECT_LE(vz, v_rec * (1.0 + 1e-6));
 }
 
 // Two spheres flying apart with a positive gap are released; approaching ones are not.

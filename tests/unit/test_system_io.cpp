@@ -33,9 +33,9 @@ ContactSystem sample_system(int rows = 6)
   bodies[1].torque = Vec3(1e300, -1.0 / 7.0, 3.0);
   std::vector<Contact> contacts = pile.contacts();
   contacts[0].compliance = {1e-8, 2e-8, 3e-8, 4e-8, 5e-8, 6e-8};
-  contacts[1].friction = FrictionParams{0.3, 1.0 / 3.0, 0.0};   // per contact since version 2
-  contacts[1].restitution = 0.7;                                // since version 3
-  contacts[2].elastic = {false, true, true, false, true, true}; // since version 4
+  contacts[1].friction = FrictionParams{0.3, 1.0 / 3.0, 0.0};  // per contact since version 2
+  contacts[1].restitution = 0.7;                               // since version 3
+  contacts[2].elastic = {true, true, true, false, true, true}; // since version 4 (5: row 0)
   contacts[2].spring = {0.0, 1.0 / 3.0, -2e-7, 0.0, 1e-300, -0.5};
   ContactSystem sys(bodies, contacts, rows, p.spook, pile.num_bodies() - 4);
   std::vector<unsigned char> mask(sys.contact_dofs(), 1);
@@ -155,7 +155,7 @@ TEST(SystemIo, RoundTripIsExact)
   for (int rows : {6, 3}) {
     const ContactSystem sys = sample_system(rows);
     const std::string text = to_text(sys);
-    EXPECT_EQ(text.rfind("fibre_contact_system 4\n", 0), 0u);
+    EXPECT_EQ(text.rfind("fibre_contact_system 5\n", 0), 0u);
     const ContactSystem back = parse_system(text);
     expect_identical(sys, back);
     EXPECT_EQ(to_text(back), text); // and the writer is deterministic
@@ -185,7 +185,7 @@ std::string older_version(const ContactSystem &sys, int version, int drop_spook,
     }
     out += line + "\n";
   }
-  out.replace(0, std::string("fibre_contact_system 4").size(),
+  out.replace(0, std::string("fibre_contact_system 5").size(),
               "fibre_contact_system " + std::to_string(version));
   return out;
 }
@@ -210,6 +210,16 @@ TEST(SystemIo, OlderVersionsAndCoefficientFields)
   const ContactSystem v3 = parse_system(older_version(sys, 3, 0, 6));
   EXPECT_EQ(v3.contacts()[1].restitution, 0.7);
   EXPECT_FALSE(v3.contacts()[2].any_elastic());
+  // version 4 knows the elastic rows 1..5 only: bit 5 (the normal row) is an error there,
+  // and without it the normal row reads rigid
+  const std::string v4_text = older_version(sys, 4, 0, 0);
+  expect_error(v4_text, {"contact 2:", "rows 1 to 5, in [0, 31]"});
+  const std::size_t mask_at = v4_text.find(" 59 ", v4_text.find("contacts "));
+  ASSERT_NE(mask_at, std::string::npos); // contact 2's mask: rows 0, 1, 2, 4, 5
+  const ContactSystem v4 =
+      parse_system(v4_text.substr(0, mask_at) + " 27 " + v4_text.substr(mask_at + 4));
+  EXPECT_FALSE(v4.contacts()[2].elastic[0]);
+  EXPECT_TRUE(v4.contacts()[2].elastic[1]);
   EXPECT_EQ(v3.contacts()[2].spring, (std::array<double, kMaxRows>{}));
   // the first contact line with a negative twisting coefficient, a restitution of 2 and a
   // negative damping other than -1
@@ -231,7 +241,7 @@ TEST(SystemIo, OlderVersionsAndCoefficientFields)
   expect_error(with(24, "2"), {"contact 0:", "restitution must be in [0, 1]"});
   expect_error(with(25, "-2"), {"contact 0:", "damping must be non-negative"});
   EXPECT_EQ(parse_system(with(25, "-1")).contacts()[0].damping, -1.0);
-  expect_error(with(32, "32"), {"contact 0:", "elastic rows must be a bit mask"});
+  expect_error(with(32, "64"), {"contact 0:", "elastic rows must be a bit mask"});
   expect_error(with(33, "0.5"), {"contact 0:", "a spring on row 1, which is not elastic"});
   const Contact elastic = parse_system(with(32, "9")).contacts()[0]; // rows 1 and 4
   EXPECT_TRUE(elastic.elastic[1] && elastic.elastic[4] && !elastic.elastic[2]);
@@ -282,7 +292,7 @@ TEST(SystemIo, EachMalformedInputGetsItsOwnError)
 
   expect_error("", {"line 1:", "unexpected end of input", "header"});
   expect_error(edit(0, "fibre_contact_sistem 1"), {"line 1:", "not a fibre_contact system"});
-  expect_error(edit(0, "fibre_contact_system 5"), {"unsupported format version 5"});
+  expect_error(edit(0, "fibre_contact_system 6"), {"unsupported format version 6"});
   expect_error(edit(0, "fibre_contact_system one"), {"'one' is not an integer"});
   expect_error(edit(2, "rows 4"), {"rows must be 3 or 6"});
   expect_error(edit(3, "spook 0 2"), {"time step h must be positive"});

@@ -68,8 +68,9 @@ struct Contact {
   // Elastic rows (compliance material): a row whose compliance is the law's spring carries
   // its displacement at the step's start, in the contact frame, in the rhs as the normal row
   // carries the gap: rows 1, 2 the tangential displacement (length), 3 the twisting and 4, 5
-  // the rolling angle. Row 0 is never elastic here (its displacement is the gap). Without the
-  // displacement a compliance would be a viscosity.
+  // the rolling angle. Without the displacement a compliance would be a viscosity. An elastic
+  // normal row (row 0, its displacement the gap, spring[0] unused) is the law's spring: its
+  // overlap is the load's, not an error, so max_recovery does not bound it.
   std::array<bool, kMaxRows> elastic{};
   std::array<double, kMaxRows> spring{};
   bool any_elastic() const
@@ -122,11 +123,13 @@ struct SpookParams {
   double bounce_speed = 0.0;
   // A contact's damping: its own when set (Contact::damping >= 0), else the system's.
   double damping_of(const Contact &c) const { return c.damping >= 0 ? c.damping : damping; }
-  // The gap term of the normal row's rhs, -(4 / h) Upsilon g, bounded by max_recovery.
-  double gap_term(double gap, double ups) const
+  // The gap term of the normal row's rhs, -(4 / h) Upsilon g, bounded by max_recovery unless
+  // the row is the material's spring (Contact::elastic[0]): bounding an elastic overlap would
+  // bound the force the contact can carry, and a wedged sphere would stay deep in.
+  double gap_term(double gap, double ups, bool elastic = false) const
   {
     const double term = -4.0 / h * ups * gap;
-    return max_recovery > 0 && term > max_recovery ? max_recovery : term;
+    return !elastic && max_recovery > 0 && term > max_recovery ? max_recovery : term;
   }
   double gap_term(double gap) const { return gap_term(gap, upsilon()); }
   // The same term of an elastic row's displacement, unbounded (the cone bounds the spring).
