@@ -17,6 +17,57 @@ using namespace LAMMPS_NS;
 
 namespace fibre_lmp {
 
+namespace {
+
+bool is_combined(const Region *region)
+{
+  const std::string style = region->style;
+  return style == "union" || style == "intersect";
+}
+
+// The sub-region that made contact `iwall` of a union or intersect, recursively (the region
+// itself when it is not combined). LAMMPS numbers a combined region's contacts by sub-region:
+// with `side in` the sub-region's own number plus the cmax of the sub-regions before it, with
+// `side out` the sub-region's index in the list.
+Region *contact_owner(Domain *domain, Region *region, int iwall)
+{
+  while (is_combined(region)) {
+    Region *owner = nullptr;
+    if (!region->interior) {
+      if (iwall < 0 || iwall >= region->nregion) return region;
+      owner = domain->regions[region->list[iwall]];
+      iwall = 0;
+    } else {
+      for (int i = 0; i < region->nregion && !owner; ++i) {
+        Region *sub = domain->regions[region->list[i]];
+        if (iwall < sub->cmax)
+          owner = sub;
+        else
+          iwall -= sub->cmax;
+      }
+      if (!owner) return region;
+    }
+    region = owner;
+  }
+  return region;
+}
+
+// A moving (sub-)region's surface velocity at point p and its angular velocity, from its
+// displacement and rotation over the last step (set_velocity, LAMMPS's differencing).
+void surface_velocity(const Region *region, const double *p, fibre::Vec3 &v, fibre::Vec3 &w)
+{
+  v = region->moveflag ? fibre::Vec3(region->v[0], region->v[1], region->v[2])
+                       : fibre::Vec3::Zero();
+  w = fibre::Vec3::Zero();
+  if (!region->rotateflag) return;
+  w = fibre::Vec3(region->omega[0], region->omega[1], region->omega[2]);
+  const fibre::Vec3 arm(p[0] - region->rpoint[0], p[1] - region->rpoint[1],
+                        p[2] - region->rpoint[2]);
+  v += w.cross(arm);
+}
+
+} // namespace
+
 LammpsDetection::LammpsDetection(LAMMPS *lmp, int groupbit, LammpsExchange &exchange)
     : Pointers(lmp), groupbit_(groupbit), exchange_(exchange)
 {
@@ -34,13 +85,17 @@ void LammpsDetection::init_walls(const std::vector<fibre::WallSpec> &walls)
       error->all(FLERR,
                  "Region ID '" + id + "' for fix fibre_contact 'wall region' does not exist");
     Region *region = domain->regions[regions_[w]];
-    // A union or intersect takes `dynamic` from moving sub-regions, but LAMMPS gives the
-    // velocity of the combined region only (zero): its moving parts would act as static walls.
-    const std::string style = region->style;
-    if (region->dynamic && (style == "union" || style == "intersect"))
-      error->all(FLERR, "Fix fibre_contact 'wall region " + id + "': region style " + style +
-                            " with moving sub-regions has no surface velocity; give each moving "
-                            "sub-region its own 'wall region' keyword");
+    // A union or intersect moves with its sub-regions (contact_owner); with `side out` LAMMPS
+    // numbers the contacts of a nested union or intersect by its index only.
+    if (is_combined(region) && region->dynamic && !region->interior)
+      for (int i = 0; i < region->nregion; ++i) {
+        const Region *sub = domain->regions[region->list[i]];
+        if (is_combined(sub) && sub->dynamic)
+          error->all(FLERR, "Fix fibre_contact 'wall region " + id + "': a moving " + sub->style +
+                                " inside a region with 'side out' is not "
+                                "supported; list its sub-regions in " +
+                                id + " instead");
+      }
     if (region->varshape)
       error->all(FLERR, "Fix fibre_contact 'wall region " + id +
                             "': a region whose shape changes over time (variable radius) is "
@@ -273,12 +328,11 @@ void LammpsDetection::wall_contacts(const std::vector<fibre::Body> &bodies, doub
         add_wall_contact(bodies, k, n, rc.r, w, std::min(rc.iwall, fibre::kWallKeyStride - 1), h,
                          damping, found);
         if (!moving || found.size() == before) continue;
-        double x[3] = {b.x[0], b.x[1], b.x[2]}, vwall[3];
-        region->velocity_contact(vwall, x, c);
+        // the surface point, and the (sub-)region it belongs to
+        const double p[3] = {b.x[0] - rc.delx, b.x[1] - rc.dely, b.x[2] - rc.delz};
         fibre::Contact &contact = found.back().contact;
-        contact.wall_v = fibre::Vec3(vwall[0], vwall[1], vwall[2]);
-        if (region->rotateflag)
-          contact.wall_omega = fibre::Vec3(region->omega[0], region->omega[1], region->omega[2]);
+        surface_velocity(contact_owner(domain, region, rc.iwall), p, contact.wall_v,
+                         contact.wall_omega);
       }
     }
   }

@@ -146,6 +146,14 @@ void FibreOutput::export_step(const std::string &prefix, const fibre::ContactSys
   std::fclose(fp);
 }
 
+void FibreOutput::add_work(const fibre::ContactWork &work)
+{
+  double sums[2] = {work.wall_work, work.dissipation};
+  MPI_Allreduce(MPI_IN_PLACE, sums, 2, MPI_DOUBLE, MPI_SUM, world);
+  stats_[V_WALL_WORK] += sums[0];
+  stats_[V_DISSIPATION] += sums[1];
+}
+
 // Counters and the last step's figures.
 void FibreOutput::write_restart(FILE *fp) const
 {
@@ -163,7 +171,10 @@ void FibreOutput::write_restart(FILE *fp) const
 void FibreOutput::read_restart(const char *buf)
 {
   const double *list = reinterpret_cast<const double *>(buf);
-  const int values = list[0] == kRestartFormat ? V_SIZE : list[0] == 2.0 ? V_ERROR_ESTIMATE : 0;
+  const int values = list[0] == kRestartFormat ? V_SIZE
+                     : list[0] == 3.0          ? V_WALL_WORK
+                     : list[0] == 2.0          ? V_ERROR_ESTIMATE
+                                               : 0;
   if (values == 0) {
     error->warning(FLERR, std::string("Fix fibre_contact: restart data of another format ignored"));
     return;

@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "fibre/detection.hpp"
+#include "fibre/spook.hpp"
 #include "fibre/step_solver.hpp"
 #include "pointers.h"
 
@@ -30,13 +31,15 @@ enum Stat {
   V_SWEEPS,
   V_SWEEP_TIME,
   V_ERROR_ESTIMATE,
+  V_WALL_WORK,   // cumulative, since the fix was defined (kept across restarts)
+  V_DISSIPATION, // cumulative, likewise
   V_SIZE
 };
 
 class FibreOutput : protected LAMMPS_NS::Pointers {
  public:
   static constexpr int kLocalColumns = 8;
-  static constexpr double kRestartFormat = 3.0; // 3: 16 global values (2: 15, still read)
+  static constexpr double kRestartFormat = 4.0; // 4: 18 global values (3: 16, 2: 15, still read)
 
   explicit FibreOutput(LAMMPS_NS::LAMMPS *lmp) : Pointers(lmp) {}
   ~FibreOutput() override;
@@ -49,6 +52,8 @@ class FibreOutput : protected LAMMPS_NS::Pointers {
   // The solve's figures (summed or maximised over processes), with a warning at most every
   // 100 steps while solves fail. A step without contacts reports an empty, converged result.
   void report_solve(const fibre::StepResult &res);
+  // Adds one step's work of the contacts (this process's contacts; summed here).
+  void add_work(const fibre::ContactWork &work);
   // One row per contact: tags, wall, gap, |normal|, |friction|, |rolling|, |twisting| impulse.
   void fill_local(const std::vector<fibre::DetectedContact> &found, const fibre::Vector *lambda,
                   int rows, double **&array_local, int &size_local_rows);

@@ -54,7 +54,10 @@ FixFibreContact::FixFibreContact(LAMMPS *lmp, int narg, char **arg) : Fix(lmp, n
   vector_flag = 1;
   size_vector = fibre_lmp::V_SIZE;
   global_freq = 1;
-  extvector = 0;
+  // intensive but for the cumulative energies (thermo_modify norm divides those by atoms)
+  extvector = -1;
+  extlist = new int[fibre_lmp::V_SIZE]();
+  extlist[fibre_lmp::V_WALL_WORK] = extlist[fibre_lmp::V_DISSIPATION] = 1;
   local_flag = 1;
   size_local_rows = 0;
   size_local_cols = FibreOutput::kLocalColumns;
@@ -108,6 +111,7 @@ double FixFibreContact::simulated_time() const
 FixFibreContact::~FixFibreContact()
 {
   if (copymode) return;
+  delete[] extlist;
   atom->delete_callback(id, Atom::GROW);
   atom->delete_callback(id, Atom::RESTART);
   if (pair_ && force && force->pair == pair_) pair_->compute_flag = 1;
@@ -452,6 +456,8 @@ void FixFibreContact::final_integrate()
   std::vector<std::array<double, fibre::kMaxRows>> springs;
   if (any && model.compliance.material)
     springs = fibre::advance_springs(sys, *exchange_, res.lambda);
+  // the energy the moving walls put in and the contacts take out (collective)
+  if (any) output_->add_work(fibre::contact_work(sys, *exchange_, res.lambda));
   overflow_count_ += history_.store(found, res.lambda, model.rows, dtv_, atom->nlocal,
                                     springs.empty() ? nullptr : &springs);
 

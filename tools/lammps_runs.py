@@ -15,6 +15,8 @@ import shutil
 SCENE_FILES = {
     "silo": ["in.silo", "in.silo.native", "scene.silo", "run.silo"],
     "material": ["in.material", "in.material.native", "scene.material", "run.material"],
+    "drum": ["in.drum", "in.drum.native", "scene.drum", "run.drum"],
+    "shear": ["in.shear", "in.shear.native", "scene.shear", "run.shear"],
 }
 
 

@@ -96,15 +96,39 @@ Vector velocity_change(const ContactSystem &sys, const Exchange &ex, const Vecto
   return dv;
 }
 
+Vector velocities_after(const ContactSystem &sys, const Exchange &ex, const Vector &lambda)
+{
+  Vector v_plus = body_velocities(sys) + external_velocity_change(sys);
+  if (lambda.size() == sys.contact_dofs()) v_plus += velocity_change(sys, ex, lambda);
+  return v_plus;
+}
+
+ContactWork contact_work(const ContactSystem &sys, const Exchange &ex, const Vector &lambda)
+{
+  const Vector v_mid = 0.5 * (body_velocities(sys) + velocities_after(sys, ex, lambda));
+  ContactWork work;
+  if (lambda.size() != sys.contact_dofs()) return work;
+  Vector Gv;
+  g_apply(sys, v_mid, Gv);
+  const int rows = sys.rows();
+  for (int c = 0; c < sys.num_contacts(); ++c) {
+    const std::array<double, kMaxRows> wall = wall_rows(sys.contacts()[c]);
+    for (int r = 0; r < rows; ++r) {
+      const double l = lambda[Eigen::Index(rows) * c + r];
+      work.wall_work += l * wall[r];
+      work.dissipation -= l * (Gv[Eigen::Index(rows) * c + r] - wall[r]);
+    }
+  }
+  return work;
+}
+
 std::vector<std::array<double, kMaxRows>> advance_springs(const ContactSystem &sys,
                                                           const Exchange &ex, const Vector &lambda)
 {
   const int rows = sys.rows(), nc = sys.num_contacts();
   std::vector<std::array<double, kMaxRows>> springs(nc);
-  Vector v_plus = body_velocities(sys) + external_velocity_change(sys);
-  if (lambda.size() == sys.contact_dofs()) v_plus += velocity_change(sys, ex, lambda);
   Vector Gv;
-  g_apply(sys, v_plus, Gv);
+  g_apply(sys, velocities_after(sys, ex, lambda), Gv);
   const Cones cones(sys);
   const double h = sys.params().h;
   for (int c = 0; c < nc; ++c) {

@@ -101,11 +101,14 @@ CASES = [
      {"pair": "", "post": GRAN}),
     ("pair_compute_yes", "", "pair style's force computation is on",
      {"post": "pair_modify compute yes"}),
-    ("moving_union", "wall region cup", "region style union with moving sub-regions has no "
-     "surface velocity", {"pre": "variable vz equal 0.1*time\n"
-                         "region c1 cylinder z 0 0 2.5 0 5 side in move NULL NULL v_vz units box\n"
-                         "region c2 sphere 0 0 0 1 side in units box\n"
-                         "region cup union 2 c1 c2"}),
+    ("moving_union_side_out", "wall region cup", "a moving union inside a region with 'side "
+     "out' is not supported", {"pre": "variable vz equal 0.1*time\n"
+                              "region c1 cylinder z 0 0 2.5 0 5 side in move NULL NULL v_vz "
+                              "units box\n"
+                              "region c2 sphere 0 0 0 1 side in units box\n"
+                              "region inner union 2 c1 c2\n"
+                              "region c3 sphere 0 0 8 1 side in units box\n"
+                              "region cup union 2 inner c3 side out"}),
     ("varshape_region", "wall region ball", "a region whose shape changes over time",
      {"pre": "variable rad equal 2.0+0.1*time\nregion ball sphere 0 0 2 v_rad side in units box"}),
     ("two_d", "", "requires a 3d simulation", {"deck": TWO_D}),

@@ -3,12 +3,19 @@
 - Conveyor: a sphere dropped onto a block region that moves at U = 1 m/s (`region ... move`).
   Friction drags it until it rolls without slipping on the belt: its centre then moves at
   2 U / 7 (angular momentum about the contact point is conserved from rest). With a rolling
-  resistance that forbids rolling it moves with the belt, at U.
+  resistance that forbids rolling it moves with the belt, at U. The energy balance: the belt
+  does the work F U t = m U v (f_fc[17]); Coulomb sliding dissipates mu m g times the mean
+  slip speed U / 2 over the slip time (f_fc[18]): 2/7 and 1/7 m U^2 rolling, m U^2 and
+  1/2 m U^2 without rolling; the kinetic energy gained is their difference.
 - Drum: a sphere inside a cylinder that rotates about its axis at omega = 10 rad/s
   (`region ... rotate`, omega^2 (R - r) = 25 g: a centrifuge). Friction and rolling resistance
   carry it with the wall: its speed becomes omega (R - r), and over 10 revolutions it stays on
   the wall (distance from the axis R - r within 1% of r: the step's straight drift overlaps
   the curved wall by (h v)^2 / 2 (R - r)) without crossing it.
+- Unions (side in): the drum made of two rotating cylinders, the sphere in the second,
+  carries it as the single cylinder does; the spaces above two belts moving in opposite
+  directions (a union of two moving blocks) carry a sphere each at 2 U / 7 in its belt's
+  direction: each contact takes the velocity of the sub-region it touches.
 - Obstacle: an atom outside the group moved by `fix move linear` pushes a free sphere
   (frictionless, no gravity): the sphere moves at the obstacle's speed and the overlap stays
   below that speed times dt.
@@ -54,7 +61,9 @@ def conveyor(args, ck, np, mu_roll):
         "timestep %g" % DT,
         "fix g all gravity 9.81 vector 0 0 -1",
         "fix fc all fibre_contact wall region belt mu 0.5 mu_roll %g" % mu_roll,
-    ] + thermo() + ["thermo 100", "run 3000"]
+        "compute rot all erotate/sphere",
+        "compute ke all ke",  # thermo ke leaves out the centre of mass: 0 for one sphere
+    ] + thermo("f_fc[17] f_fc[18] c_ke c_rot") + ["thermo 100", "run 3000"]
     tag = "conveyor_roll%g_np%d" % (mu_roll, np)
     run = e2e.run_lmp(args, "\n".join(lines) + "\n", tag, np=np)
     if not ck.ran(run, "%s: run completes" % tag):
@@ -67,9 +76,19 @@ def conveyor(args, ck, np, mu_roll):
     ck.check(min(zs[1:]) > 0.5 - 0.01 and abs(last["v_vz1"]) < 1e-6,
              "%s: the sphere stays on the belt's surface" % tag,
              "lowest z %.6g, final vz %.3g" % (min(zs[1:]), last["v_vz1"]))
+    m = math.pi / 6.0  # diameter 1, density 1
+    work, dissipated = (1.0, 0.5) if mu_roll > 0 else (2.0 / 7.0, 1.0 / 7.0)
+    ck.agree(last["f_fc[17]"], work * m * U * U, 2e-2, "%s: the belt's work is m U v" % tag)
+    ck.agree(last["f_fc[18]"], dissipated * m * U * U, 2e-2,
+             "%s: sliding dissipates mu m g U t / 2" % tag)
+    first = run.thermo[-1][0]
+    gained = last["c_ke"] + last["c_rot"] - (first["c_ke"] + first["c_rot"])
+    # exact but for gravity's work on the sphere's micro-motion in the compliant normal row
+    ck.agree(last["f_fc[17]"] - last["f_fc[18]"], gained, 1e-4,
+             "%s: the work less the dissipation is the kinetic energy gained" % tag)
 
 
-def drum(args, ck, np):
+def drum(args, ck, np, union=False):
     R, r, omega = 3.0, 0.5, 10.0
     revolutions = 10
     steps = int(revolutions * 2 * math.pi / omega / DT)
@@ -77,7 +96,13 @@ def drum(args, ck, np):
         "create_atoms 1 single 0 0 %g units box" % (-(R - r)),
         "set atom 1 diameter 1.0 density 1.0",
         "variable theta equal %g*time" % omega,
+    ] + ([
+        "region left cylinder y 0 0 %g -1.5 -0.3 rotate v_theta 0 0 0 0 1 0 units box" % R,
+        "region right cylinder y 0 0 %g -0.3 1.5 rotate v_theta 0 0 0 0 1 0 units box" % R,
+        "region drum union 2 left right side in units box",
+    ] if union else [
         "region drum cylinder y 0 0 %g -1.5 1.5 side in rotate v_theta 0 0 0 0 1 0 units box" % R,
+    ]) + [
         "pair_style gran/hooke 1.0 NULL 0.0 NULL 1.0 0",
         "pair_coeff * *",
         "neighbor 0.2 bin",
@@ -87,7 +112,7 @@ def drum(args, ck, np):
         "variable rho equal sqrt(x[1]^2+z[1]^2)",
         "variable speed equal sqrt(vx[1]^2+vy[1]^2+vz[1]^2)",
     ] + thermo("v_rho v_speed") + ["thermo 50", "run %d" % steps]
-    tag = "drum_np%d" % np
+    tag = "drum%s_np%d" % ("_union" if union else "", np)
     run = e2e.run_lmp(args, "\n".join(lines) + "\n", tag, np=np)
     if not ck.ran(run, "%s: run completes" % tag):
         return
@@ -105,6 +130,34 @@ def drum(args, ck, np):
              "distance from the axis %.6g .. %.6g (R - r = %g)" % (min(rho), max(rho), R - r))
     ck.check(rows[-1]["v_vy1"] == 0.0 or abs(rows[-1]["v_vy1"]) < 1e-9,
              "%s: no motion along the axis" % tag, "vy %.3g" % rows[-1]["v_vy1"])
+
+
+def belts(args, ck, np):
+    """Two belts, one union: each sphere rides its own belt's velocity."""
+    U1, U2 = 1.0, -0.5
+    lines = header(np, "-20 20 -3 3 -2 5") + [
+        "create_atoms 1 single -10 0 0.5 units box",
+        "create_atoms 1 single 10 0 0.5 units box",
+        "set atom * diameter 1.0 density 1.0",
+        "variable s1 equal %g*time" % U1,
+        "variable s2 equal %g*time" % U2,
+        "region b1 block -100 0 -2.5 2.5 0 4 move v_s1 NULL NULL units box",
+        "region b2 block 0 100 -2.5 2.5 0 4 move v_s2 NULL NULL units box",
+        "region belts union 2 b1 b2 side in units box",
+        "pair_style gran/hooke 1.0 NULL 0.0 NULL 0.5 0",
+        "pair_coeff * *",
+        "neighbor 0.2 bin",
+        "timestep %g" % DT,
+        "fix g all gravity 9.81 vector 0 0 -1",
+        "fix fc all fibre_contact wall region belts mu 0.5",
+        "variable vx2 equal vx[2]",
+    ] + thermo("v_vx2") + ["thermo 100", "run 3000"]
+    tag = "belts_union_np%d" % np
+    run = e2e.run_lmp(args, "\n".join(lines) + "\n", tag, np=np)
+    if not ck.ran(run, "%s: run completes" % tag):
+        return
+    ck.agree(run.last("v_vx1"), 2.0 * U1 / 7.0, 1e-3, "%s: the first belt's sphere at 2 U1 / 7" % tag)
+    ck.agree(run.last("v_vx2"), 2.0 * U2 / 7.0, 1e-3, "%s: the second's at 2 U2 / 7" % tag)
 
 
 def obstacle(args, ck, np):
@@ -179,6 +232,8 @@ def main():
         conveyor(args, ck, np, 0.0)
         conveyor(args, ck, np, 1.0)
         drum(args, ck, np)
+        drum(args, ck, np, union=True)
+        belts(args, ck, np)
         obstacle(args, ck, np)
         planes(args, ck, np)
     ck.close()

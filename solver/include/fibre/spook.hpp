@@ -25,6 +25,22 @@ Vector spook_rhs(const ContactSystem &sys, const Vector *extra_dv = nullptr);
 // complete on owned bodies and ghosts. The one place this product is written.
 Vector velocity_change(const ContactSystem &sys, const Exchange &ex, const Vector &lambda);
 
+// v+ = v + h M^-1 f + M^-1 G^T lambda, the velocities after the step, complete on ghosts.
+// Collective (velocity_change). lambda may be empty (no contacts): free flight.
+Vector velocities_after(const ContactSystem &sys, const Exchange &ex, const Vector &lambda);
+
+// The step's work of the contact impulses, this process's contacts (sum over processes):
+// `wall_work` is done on the bodies by moving walls and obstacles, lambda . (G_b w_b) with w_b
+// the wall's velocity; `dissipation` is lambda . the relative velocity at the step's mean
+// velocity (v + v+) / 2, with a minus sign: the energy the contacts take out (dissipated, or
+// stored in compliant rows). Their kinetic energy change is wall_work - dissipation, exactly,
+// since the impulses change v linearly. Collective (velocities_after).
+struct ContactWork {
+  double wall_work = 0.0;
+  double dissipation = 0.0;
+};
+ContactWork contact_work(const ContactSystem &sys, const Exchange &ex, const Vector &lambda);
+
 // The elastic rows' displacements at the step's end, rows per contact in each contact's frame
 // (Contact::spring): spring + h G v+ on every elastic row, with v+ = v + h M^-1 f + M^-1 G^T
 // lambda the velocities after the step, ghosts included. On a cone at its limit the spring
