@@ -57,6 +57,15 @@ void FibreOutput::report_solve(const fibre::StepResult &res)
   stats_[V_SOLVE] = times[1];
   stats_[V_SWEEP_TIME] = times[2];
 
+  if (res.restarted && comm->me == 0 &&
+      (last_restart_warning_ < 0 || update->ntimestep - last_restart_warning_ >= 100)) {
+    error->warning(FLERR, "Fix fibre_contact: at step " +
+                              std::to_string(static_cast<long long>(update->ntimestep)) +
+                              " the linear pass left the impulses worse than the warm start; "
+                              "the sweeps restarted from the warm start (complementarity " +
+                              fibre::format_g(res.complementarity) + ")");
+    last_restart_warning_ = update->ntimestep;
+  }
   if (!res.converged) {
     ++nonconverged_total_;
     ++nonconverged_since_warning_;

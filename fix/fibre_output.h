@@ -72,6 +72,7 @@ class FibreOutput : protected LAMMPS_NS::Pointers {
   LAMMPS_NS::bigint nonconverged_total_ = 0;
   LAMMPS_NS::bigint nonconverged_since_warning_ = 0;
   LAMMPS_NS::bigint last_warning_step_ = -1;
+  LAMMPS_NS::bigint last_restart_warning_ = -1;
   int maxlocal_ = 0;
   double **local_array_ = nullptr;
 };

@@ -374,12 +374,34 @@ StepResult StepSolver::run(const Vector *warm)
   sys_.set_row_mask(all_rows_);
   b_full_ = spook_rhs(sys_);
   Vector lambda = initial_impulses(warm);
+  // The projected warm start and its residual: the step never ends worse than the sweeps
+  // alone would leave it from there.
+  Vector start = lambda;
+  project(start);
+  const double start_residual =
+      sweeps_only() ? 0.0 : complementarity(sys_, ex_, cones_, b_full_, start, row_scales(sys_));
   if (!sweeps_only()) active_set_loop(lambda, res);
   // Feasible impulses, then projected Gauss-Seidel sweeps while they are not accurate enough.
   // (Projecting an unsettled pass alone could zero a tensile impulse that balances large
   // compressive ones and kick the bodies between them: 29 m/s in one silo step.)
   project(lambda);
   if (last_reason_ != StopReason::non_finite) finish(lambda, res);
+  // A pass whose projection the sweeps could not repair (a jammed pack under a moving wall:
+  // residual 1.45 from a warm start at 0.04, bodies thrown at 70 m/s): sweep from the warm
+  // start instead, and keep the better of the two.
+  if (!sweeps_only() && !(res.complementarity <= std::max(start_residual, opt_.sweep_tol))) {
+    StepResult again = res;
+    finish(start, again);
+    res.sweeps += again.sweeps;
+    res.sweep_seconds += again.sweep_seconds;
+    if (!(again.complementarity >= res.complementarity)) {
+      lambda = std::move(start);
+      res.complementarity = again.complementarity;
+      res.error_estimate = again.error_estimate;
+      res.sweep_reason = again.sweep_reason;
+      res.restarted = true;
+    }
+  }
   if (sweeps_only() && res.complementarity > opt_.sweep_tol) {
     res.converged = false;
     // sweeps that stopped moving above the tolerance stagnated

@@ -266,7 +266,9 @@ TEST(ContactSolver, RecoverySpeedBoundsRigidRowsNotTheMaterialsSpring)
     std::array<double, kMaxRows> rigid{};
     rigid.fill(1e-12);
     ASSERT_TRUE(material_compliance(law, r, -c.gap, force, rigid, c.compliance, c.elastic));
-    if (s == 0) ASSERT_TRUE(c.elastic[0]);
+    if (s == 0) {
+      ASSERT_TRUE(c.elastic[0]);
+    }
     c.damping = std::max(2.0, 2.0 * std::sqrt(m * c.compliance[0]) / kH); // critical, as the fix
     ContactSystem sys(bodies, {c}, 3, params);
     const StepResult res = solve(sys, o);

@@ -65,6 +65,9 @@ struct StepResult {
   // in contact_solver.cpp): 0 for an exact solution of the nonsmooth step.
   double complementarity = 0;
   int sweeps = 0; // projected Gauss-Seidel sweeps done after the loop
+  // The linear passes left the step worse than its warm start (complementarity residual), so
+  // the sweeps started again from the warm start and their result was kept.
+  bool restarted = false;
   StopReason sweep_reason = StopReason::converged; // of the sweeps (converged when none ran)
   // The impulses' remaining relative error as the sweeps estimate it (PgsResult): infinite
   // when they did not contract, the complementarity residual when none ran.
