@@ -66,6 +66,32 @@ void surface_velocity(const Region *region, const double *p, fibre::Vec3 &v, fib
   v += w.cross(arm);
 }
 
+// A bound of the surface speed of a moving region (and of its moving sub-regions) within the
+// sphere's reach: translation plus rotation at the sphere's distance from the axis point.
+double speed_bound(Domain *domain, const Region *region, const double *x, double radius)
+{
+  if (is_combined(region)) {
+    double most = 0.0;
+    for (int i = 0; i < region->nregion; ++i)
+      most = std::max(most, speed_bound(domain, domain->regions[region->list[i]], x, radius));
+    return most;
+  }
+  if (!region->dynamic) return 0.0;
+  double speed = region->moveflag
+                     ? std::sqrt(region->v[0] * region->v[0] + region->v[1] * region->v[1] +
+                                 region->v[2] * region->v[2])
+                     : 0.0;
+  if (region->rotateflag) {
+    const double w =
+        std::sqrt(region->omega[0] * region->omega[0] + region->omega[1] * region->omega[1] +
+                  region->omega[2] * region->omega[2]);
+    const double dx = x[0] - region->rpoint[0], dy = x[1] - region->rpoint[1],
+                 dz = x[2] - region->rpoint[2];
+    speed += w * (std::sqrt(dx * dx + dy * dy + dz * dz) + radius);
+  }
+  return speed;
+}
+
 } // namespace
 
 LammpsDetection::LammpsDetection(LAMMPS *lmp, int groupbit, LammpsExchange &exchange)
@@ -261,7 +287,7 @@ void LammpsDetection::pair_contacts(const std::vector<fibre::Body> &bodies, doub
         fc.contact.wall_v = vo + wo.cross(fc.contact.point - xo);
         fc.contact.wall_omega = wo;
         if (!fibre::is_contact(bodies[atom_body_[g]], nullptr, n, fc.contact.gap, h, damping,
-                               kick(atom_body_[g])))
+                               kick(atom_body_[g]), n.dot(fc.contact.wall_v)))
           continue;
         fc.tag_a = tag[g];
         fc.partner = static_cast<double>(tag[o]);
@@ -274,14 +300,17 @@ void LammpsDetection::pair_contacts(const std::vector<fibre::Body> &bodies, doub
 
 void LammpsDetection::add_wall_contact(const std::vector<fibre::Body> &bodies, int body,
                                        const fibre::Vec3 &n, double distance, int wall, int sub,
+                                       const fibre::Vec3 &wall_v, const fibre::Vec3 &wall_omega,
                                        double h, double damping,
                                        std::vector<fibre::DetectedContact> &found) const
 {
   if (!fibre::is_contact(bodies[body], nullptr, n, distance - bodies[body].radius, h, damping,
-                         kick(body)))
+                         kick(body), n.dot(wall_v)))
     return;
   fibre::DetectedContact fc;
   fc.contact = fibre::sphere_wall_contact(bodies, body, n, distance);
+  fc.contact.wall_v = wall_v;
+  fc.contact.wall_omega = wall_omega;
   fc.store = exchange_.body_atom()[body];
   fc.tag_a = atom->tag[fc.store];
   fc.partner = fibre::wall_key(wall, sub);
@@ -302,10 +331,8 @@ void LammpsDetection::wall_contacts(const std::vector<fibre::Body> &bodies, doub
         fibre::PlaneHit hits[2];
         const int n = fibre::plane_hits(walls_[w], bodies[k], skin, hits, wall_time_);
         for (int s = 0; s < n; ++s) {
-          const std::size_t before = found.size();
-          add_wall_contact(bodies, k, hits[s].normal, hits[s].distance, w, hits[s].sub, h, damping,
-                           found);
-          if (found.size() > before) found.back().contact.wall_v = walls_[w].velocity(wall_time_);
+          add_wall_contact(bodies, k, hits[s].normal, hits[s].distance, w, hits[s].sub,
+                           walls_[w].velocity(wall_time_), fibre::Vec3::Zero(), h, damping, found);
         }
       }
       continue;
@@ -318,21 +345,21 @@ void LammpsDetection::wall_contacts(const std::vector<fibre::Body> &bodies, doub
     if (moving) region->set_velocity();
     for (int k = 0; k < nowned; ++k) {
       const fibre::Body &b = bodies[k];
+      const double speed = moving ? speed_bound(domain, region, b.x.data(), b.radius) : 0.0;
       const int nc =
-          region->surface(b.x[0], b.x[1], b.x[2], fibre::region_cutoff(b, h, damping, skin));
+          region->surface(b.x[0], b.x[1], b.x[2], fibre::region_cutoff(b, h, damping, skin, speed));
       for (int c = 0; c < nc; ++c) {
         const Region::Contact &rc = region->contact[c];
         if (!(rc.r > 0.0)) continue;
         const fibre::Vec3 n(rc.delx / rc.r, rc.dely / rc.r, rc.delz / rc.r);
-        const std::size_t before = found.size();
-        add_wall_contact(bodies, k, n, rc.r, w, std::min(rc.iwall, fibre::kWallKeyStride - 1), h,
-                         damping, found);
-        if (!moving || found.size() == before) continue;
-        // the surface point, and the (sub-)region it belongs to
-        const double p[3] = {b.x[0] - rc.delx, b.x[1] - rc.dely, b.x[2] - rc.delz};
-        fibre::Contact &contact = found.back().contact;
-        surface_velocity(contact_owner(domain, region, rc.iwall), p, contact.wall_v,
-                         contact.wall_omega);
+        // the surface point's velocity, from the (sub-)region it belongs to
+        fibre::Vec3 wall_v = fibre::Vec3::Zero(), wall_omega = fibre::Vec3::Zero();
+        if (moving) {
+          const double p[3] = {b.x[0] - rc.delx, b.x[1] - rc.dely, b.x[2] - rc.delz};
+          surface_velocity(contact_owner(domain, region, rc.iwall), p, wall_v, wall_omega);
+        }
+        add_wall_contact(bodies, k, n, rc.r, w, std::min(rc.iwall, fibre::kWallKeyStride - 1),
+                         wall_v, wall_omega, h, damping, found);
       }
     }
   }

@@ -40,8 +40,10 @@ class LammpsDetection : protected LAMMPS_NS::Pointers {
                      std::vector<fibre::DetectedContact> &found) const;
   void wall_contacts(const std::vector<fibre::Body> &bodies, double h, double damping,
                      std::vector<fibre::DetectedContact> &found) const;
+  // A wall contact of body with the wall's surface velocity at the point and angular velocity.
   void add_wall_contact(const std::vector<fibre::Body> &bodies, int body, const fibre::Vec3 &n,
-                        double distance, int wall, int sub, double h, double damping,
+                        double distance, int wall, int sub, const fibre::Vec3 &wall_v,
+                        const fibre::Vec3 &wall_omega, double h, double damping,
                         std::vector<fibre::DetectedContact> &found) const;
 
   double kick(int body) const { return kick_.empty() ? 0.0 : kick_[body]; }

@@ -17,6 +17,7 @@ SCENE_FILES = {
     "material": ["in.material", "in.material.native", "scene.material", "run.material"],
     "drum": ["in.drum", "in.drum.native", "scene.drum", "run.drum"],
     "shear": ["in.shear", "in.shear.native", "scene.shear", "run.shear"],
+    "mixer": ["in.mixer", "in.mixer.native", "scene.mixer", "run.mixer"],
 }
 
 

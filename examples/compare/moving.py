@@ -10,6 +10,10 @@
       runs in.shear and in.shear.native in WORKDIR/shear.U.
   moving.py shear-report --U U1 U2 ... [--out DIR]
       the shear cell's effective friction and normal stress: DIR/shear.md.
+  moving.py mixer-run --period T1 T2 ... [--method ...] [--revs R] [--var N V]
+      runs in.mixer and in.mixer.native in WORKDIR/mixer.T.
+  moving.py mixer-report --period T1 T2 ... [--out DIR]
+      the blade's power and the bed's motion: DIR/mixer.md.
 
 Global options (--workdir, --np, --lmp, --lmp-fibre, --tag) go before the subcommand.
 
@@ -38,6 +42,16 @@ strain of about 1):
   p         the bulk's normal stress -sigma_zz (Pa).
   I         the inertial number gamma_dot d / sqrt(p / rho), gamma_dot = U / (Hc - 1).
   speed     wall-clock seconds per simulated second of the shear run.
+
+Mixer, over the blade's last revolution:
+
+  power     the power the blade puts into the grains: native, minus the pair forces on the
+            blade atoms times their velocity (thermo c_power, averaged); fix fibre_contact,
+            the growth of its wall work f_fc[17] over the revolution.
+  ke        the grains' kinetic energy (translational + rotational), mean.
+  lift      the rise of the grains' centre of mass over its height at rest.
+  overlap   the deepest sphere-sphere overlap (grains and blade) over the revolution's
+            snapshots (8 per revolution), in units of the smallest grain diameter (0.5).
 """
 
 import argparse
@@ -268,6 +282,65 @@ def cmd_shear_report(a):
         f.write(table + "\n")
 
 
+def mixer_dir(work, period, tag=None):
+    return os.path.join(work, "mixer.%g%s" % (period, "." + tag if tag else ""))
+
+
+def mixer_log(method, period):
+    return "log.mixer.%s.%g" % (method, period)
+
+
+def cmd_mixer_run(a):
+    for period in a.period:
+        run_twins(a, "mixer", mixer_dir(a.workdir, period, a.tag),
+                  lambda m: mixer_log(m, period), [("period", period), ("revs", a.revs)])
+
+
+def measure_mixer(a, period, method):
+    d = mixer_dir(a.workdir, period, a.tag)
+    blocks = compare.parse_thermo(os.path.join(d, mixer_log(method, period)))
+    rest, b = blocks[-2], blocks[-1]
+    t = b["Time"]
+    last = t >= t[-1] - period - 1e-9
+    if method == "native":
+        power = float(np.mean(b["c_power"][last]))
+    else:
+        i = int(np.argmax(last))
+        power = float((b["f_fc[17]"][-1] - b["f_fc[17]"][i]) / (t[-1] - t[i]))
+    ke = b["c_ke"][last] + b["c_rot"][last]
+    frames = compare.read_frames(os.path.join(d, "mixer.%s.traj" % method))
+    dt = (t[-1] - t[0]) / max(b["Step"][-1] - b["Step"][0], 1)
+    late = [c for s, c in frames if s * dt >= t[-1] - period - 1e-9]
+    deepest = max(compare.max_pair_overlap(np.stack([c["x"], c["y"], c["z"]], axis=1),
+                                           c["radius"]) for c in late)
+    return {"power": power, "ke": float(np.mean(ke)), "lift": float(np.mean(b["v_zg"][last]) -
+                                                                 rest["v_zg"][-1]),
+            "overlap": deepest / 0.5, "wall_per_s": float(b["CPU"][-1] / (t[-1] - t[0]))}
+
+
+def cmd_mixer_report(a):
+    rows = ["| period (s) | tip speed (m/s) | method | blade power (W) | grains' kinetic energy (J) "
+            "| centre of mass lift (m) | deepest overlap / d_min | wall s per simulated s | "
+            "native / fibre wall time |", "|---|---|---|---|---|---|---|---|---|"]
+    for period in a.period:
+        R = {m: measure_mixer(a, period, m) for m in METHODS}
+        for m in METHODS:
+            r = R[m]
+            ratio = ("**%.2f**" % (R["native"]["wall_per_s"] / r["wall_per_s"])
+                     if m == "fibre" else "")
+            rows.append("| %g | %.2f | %s | %.0f | %.1f | %.3f | %.3f | %.2f | %s |" % (
+                period, 2 * math.pi * 4.0 / period, m, r["power"], r["ke"], r["lift"],
+                r["overlap"], r["wall_per_s"], ratio))
+        rows.append("| %g | | fibre / native | %.3f | %.3f | %.3f | | | |" % (
+            period, R["fibre"]["power"] / R["native"]["power"], R["fibre"]["ke"] / R["native"]["ke"],
+            R["fibre"]["lift"] / R["native"]["lift"]))
+    table = "\n".join(rows)
+    print(table)
+    os.makedirs(a.out, exist_ok=True)
+    with open(os.path.join(a.out, "mixer.md"), "w") as f:
+        f.write(table + "\n")
+
+
 def main():
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0],
                                 formatter_class=argparse.RawDescriptionHelpFormatter,
@@ -297,10 +370,19 @@ def main():
     q.add_argument("--U", type=float, nargs="+", required=True)
     q.add_argument("--tskip", type=float, default=3.0, help="seconds of shear left out")
     q.add_argument("--out", default=out)
+    r = sub.add_parser("mixer-run")
+    r.add_argument("--period", type=float, nargs="+", required=True)
+    r.add_argument("--method", choices=("fibre", "native", "both"), default="both")
+    r.add_argument("--revs", type=float, default=3.0)
+    r.add_argument("--var", nargs=2, action="append", metavar=("NAME", "VALUE"))
+    q = sub.add_parser("mixer-report")
+    q.add_argument("--period", type=float, nargs="+", required=True)
+    q.add_argument("--out", default=out)
     a = p.parse_args()
     a.lmp_fibre = os.path.abspath(a.lmp_fibre)
     {"drum-run": cmd_drum_run, "drum-report": cmd_drum_report, "shear-run": cmd_shear_run,
-     "shear-report": cmd_shear_report}[a.cmd](a)
+     "shear-report": cmd_shear_report, "mixer-run": cmd_mixer_run,
+     "mixer-report": cmd_mixer_report}[a.cmd](a)
 
 
 if __name__ == "__main__":

@@ -69,6 +69,11 @@ void apply_contact_model(const ContactModel &model, double h, double m_min,
     const int ntypes = model.materials.ntypes();
     if (model.per_type() && ta >= 1 && tb >= 1 && ta <= ntypes && tb <= ntypes)
       apply_pair(model, model.materials.at(ta, tb), h, reff, bodies, last, k, c);
+    // An impact is a contact that carried no load in the last step; an enduring one does not
+    // bounce (without external forces bounce_speed is 0, and Newton's law on every contact of
+    // a sheared pack threw its grains out of the cell).
+    const Eigen::Index normal = Eigen::Index(model.rows) * Eigen::Index(k);
+    if (last && last->size() > normal && (*last)[normal] > 0.0) c.restitution = 0.0;
     // a spring's displacement lives on elastic rows only
     for (int r = 0; r < kMaxRows; ++r)
       if (!c.elastic[r]) c.spring[r] = 0.0;

@@ -14,19 +14,20 @@ double free_approach(const Body &a, const Body *b, const Vec3 &n, double h)
 }
 
 bool is_contact(const Body &a, const Body *b, const Vec3 &n, double gap, double h, double damping,
-                double kick)
+                double kick, double wall_approach)
 {
   const double rmin = b ? std::min(a.radius, b->radius) : a.radius;
   const double margin = kContactMargin * rmin + (damping + 1.0) * h * kick;
   if (gap < margin) return true;
-  const double approach = free_approach(a, b, n, h);
+  const double approach = free_approach(a, b, n, h) + wall_approach;
   return approach > 0.0 && gap < margin + (damping + 1.0) * h * approach;
 }
 
-double region_cutoff(const Body &b, double h, double damping, double skin)
+double region_cutoff(const Body &b, double h, double damping, double skin, double wall_speed)
 {
   const Vec3 vfree = b.v + (h / b.mass) * b.force;
-  return b.radius * (1.0 + kContactMargin) + std::min(skin, (damping + 1.0) * h * vfree.norm());
+  return b.radius * (1.0 + kContactMargin) +
+         std::min(skin, (damping + 1.0) * h * (vfree.norm() + wall_speed));
 }
 
 double WallSpec::offset(double t) const

@@ -53,6 +53,13 @@ TEST(Detection, ApproachWithinDampingPlusOneSteps)
   EXPECT_TRUE(is_contact(falling, &b, n, 0.005 + 0.0299, h, d));
   // a wall (b == nullptr) counts only a's motion
   EXPECT_TRUE(is_contact(a, nullptr, n, 0.005 + 0.0299, h, d));
+  // a moving wall or obstacle adds its own approach: a sphere at rest, the wall at 1 m/s
+  // towards it, is found as the moving sphere is; moving away it is not
+  const Body rest = sphere(r, Vec3(0, 0, 1.1));
+  EXPECT_FALSE(is_contact(rest, nullptr, n, 0.005 + 0.0299, h, d));
+  EXPECT_TRUE(is_contact(rest, nullptr, n, 0.005 + 0.0299, h, d, 0.0, 1.0));
+  EXPECT_FALSE(is_contact(rest, nullptr, n, 0.005 + 0.0301, h, d, 0.0, 1.0));
+  EXPECT_FALSE(is_contact(rest, nullptr, n, 0.006, h, d, 0.0, -1.0));
 }
 
 TEST(Detection, PlaneWallsBothSidesWithinReach)
@@ -88,6 +95,8 @@ TEST(Detection, RegionCutoffCappedByTheSkin)
                    0.505 + 0.06);
   EXPECT_DOUBLE_EQ(region_cutoff(sphere(0.5, Vec3::Zero(), Vec3(0, 20, 0)), h, d, 0.1),
                    0.505 + 0.1);
+  // a moving wall's surface speed near the sphere widens it alike
+  EXPECT_DOUBLE_EQ(region_cutoff(sphere(0.5, Vec3::Zero()), h, d, 0.1, 2.0), 0.505 + 0.06);
 }
 
 TEST(Detection, WallKeysAreNegativeAndDistinct)

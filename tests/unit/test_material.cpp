@@ -109,6 +109,16 @@ TEST(Material, ApplyContactModelPerType)
   EXPECT_DOUBLE_EQ(contacts[0].restitution, 0.3);
   EXPECT_DOUBLE_EQ(contacts[2].restitution, 0.0); // plastic: the model's default
   EXPECT_DOUBLE_EQ(contacts[1].restitution, 0.0); // mixing with "none" gives none
+  // a contact loaded in the last step endures: no restitution; an unloaded one is an impact
+  Vector last = Vector::Zero(6 * 4);
+  last[0] = 1e-3; // contact 0's normal impulse
+  model.restitution = 0.5;
+  model.typed.restitution = true;
+  apply_contact_model(model, 1e-3, 1.0, bodies, contacts, &last);
+  EXPECT_DOUBLE_EQ(contacts[0].restitution, 0.0);
+  EXPECT_DOUBLE_EQ(contacts[2].restitution, 0.5);
+  model.typed = TypedCoefficients{};
+  model.restitution = 0.0;
   // typed keywords override every pair; coefficients fix ignores the table
   model.typed.mu = true;
   model.friction.mu = 0.9;

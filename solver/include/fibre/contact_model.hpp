@@ -84,7 +84,8 @@ double cone_coefficient(const FrictionParams &f, double r_eff, int cone);
 // per-type coefficients a pair takes those of its bodies' types, a wall contact those of its
 // sphere's type with itself, and typed keywords override them.
 // `last` (optional, rows per contact) holds each contact's impulses of the last step, for
-// compliance material's reference load.
+// compliance material's reference load; a contact that carried a normal impulse then is an
+// enduring contact, not an impact, and gets no restitution.
 void apply_contact_model(const ContactModel &model, double h, double m_min,
                          const std::vector<Body> &bodies, std::vector<Contact> &contacts,
                          const Vector *last = nullptr);

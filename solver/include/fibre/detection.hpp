@@ -60,12 +60,14 @@ struct WallSpec {
 // under their external forces; negative when they separate. n points from b to a.
 double free_approach(const Body &a, const Body *b, const Vec3 &n, double h);
 // kick: a speed the bodies may gain within the step from impacts (any direction).
+// wall_approach: a moving wall's or obstacle's speed towards a along n (n . its velocity).
 bool is_contact(const Body &a, const Body *b, const Vec3 &n, double gap, double h, double damping,
-                double kick = 0.0);
+                double kick = 0.0, double wall_approach = 0.0);
 
 // How far from a sphere a region wall is looked for: its radius, the margin, and its
-// free-flight reach over (damping + 1) steps, capped at the neighbour skin.
-double region_cutoff(const Body &b, double h, double damping, double skin);
+// free-flight reach over (damping + 1) steps, capped at the neighbour skin; wall_speed bounds
+// the speed of a moving wall's surface near the sphere.
+double region_cutoff(const Body &b, double h, double damping, double skin, double wall_speed = 0.0);
 
 // The planes of a plane wall within `reach` of the sphere's surface: normal (into the grains),
 // centre distance and sub-wall (0 lo, 1 hi). Returns how many (0, 1 or 2) were written.
