@@ -326,10 +326,12 @@ void FixFibreContact::smallest_body(const std::vector<fibre::Body> &bodies)
 double FixFibreContact::bounce_speed(const std::vector<fibre::Body> &bodies) const
 {
   const fibre::ContactModel &model = settings_.model;
-  if (model.restitution <= 0 || model.bounce_speed >= 0) return std::max(model.bounce_speed, 0.0);
+  if (!model.may_bounce() || model.bounce_speed >= 0) return std::max(model.bounce_speed, 0.0);
   double v = fibre::external_speed_per_step(bodies, exchange_->num_owned(), dtv_);
   MPI_Allreduce(MPI_IN_PLACE, &v, 1, MPI_DOUBLE, MPI_MAX, world);
-  return model.bounce_steps * v;
+  // Without external forces every approach would bounce, the new contacts of a sheared pack
+  // too (it threw grains out of the shear cell): then the automatic overlap recovery speed.
+  return v > 0 ? model.bounce_steps * v : model.recovery_radii * r_min_ / dtv_;
 }
 
 // At the first step of a run: overlaps deeper than kDeepOverlap of the smaller diameter are

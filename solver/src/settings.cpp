@@ -283,7 +283,9 @@ std::string describe(const Settings &s)
                                          : format_g(v));
   const double vb = s.model.bounce_speed;
   out += ", restitution " + format_g(s.model.restitution) + ", bounce_speed " +
-         (vb < 0 ? "auto (" + format_g(s.model.bounce_steps) + " dt |f| / m max)" : format_g(vb));
+         (vb < 0 ? "auto (" + format_g(s.model.bounce_steps) + " dt |f| / m max, or " +
+                       format_g(s.model.recovery_radii) + " r_min / dt without forces)"
+                 : format_g(vb));
   out += std::string(", coefficients ") + to_string(s.model.coefficients);
   const FrictionParams &f = s.model.friction;
   return out + ", mu " + format_g(f.mu) + ", mu_roll " + format_g(f.mu_roll) + ", mu_twist " +

@@ -59,7 +59,8 @@ TEST(Settings, NoKeywordsKeepTheDefaults)
             "form body, solver cg, precond tree, weight z, tol 0.0001, pass_tol 0.001, maxiter "
             "200, active_set 1, sweeps 50, sweep_tol 0.001, rows 6, damping 2, compliance auto "
             "(0.01 dt^2 / m_min), recovery_speed auto (0.01 r_min / dt), restitution 0, "
-            "bounce_speed auto (2 dt |f| / m max), coefficients pair, mu 0.5, mu_roll 0, "
+            "bounce_speed auto (2 dt |f| / m max, or 0.01 r_min / dt without forces), coefficients "
+            "pair, mu 0.5, mu_roll 0, "
             "mu_twist 0");
 }
 
