@@ -2,6 +2,7 @@
 #include "lammps_exchange.h"
 
 #include <algorithm>
+#include <unordered_map>
 
 #include "atom.h"
 #include "comm.h"
@@ -19,6 +20,15 @@ void LammpsExchange::set_bodies(const std::vector<int> &body_atom, int num_owned
 {
   body_atom_ = body_atom;
   num_owned_ = num_owned;
+  // a ghost with the tag of an owned body is its periodic image on this process
+  const LAMMPS_NS::tagint *tag = lmp_->atom->tag;
+  std::unordered_map<LAMMPS_NS::tagint, int> owned;
+  for (int k = 0; k < num_owned; ++k) owned.emplace(tag[body_atom[k]], k);
+  local_owners_.resize(body_atom.size());
+  for (int k = 0; k < static_cast<int>(body_atom.size()); ++k) {
+    const auto it = k < num_owned ? owned.end() : owned.find(tag[body_atom[k]]);
+    local_owners_[k] = it == owned.end() ? k : it->second;
+  }
 }
 
 void LammpsExchange::resize_halo() const

@@ -36,6 +36,7 @@ class LammpsExchange final : public fibre::Exchange {
   void sum(double *values, int n) const override;
   void max(double *values, int n) const override;
   long exclusive_prefix_sum(long local) const override;
+  const std::vector<int> &local_owners() const override { return local_owners_; }
   using fibre::Exchange::max;
   using fibre::Exchange::sum;
 
@@ -53,6 +54,7 @@ class LammpsExchange final : public fibre::Exchange {
   MPI_Comm world_;
   std::vector<int> body_atom_;
   int num_owned_ = 0;
+  std::vector<int> local_owners_;    // periodic images of owned bodies -> those bodies
   mutable std::vector<double> halo_; // 6 per local atom (owned + ghost)
 };
 

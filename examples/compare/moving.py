@@ -14,6 +14,9 @@
       runs in.mixer and in.mixer.native in WORKDIR/mixer.T.
   moving.py mixer-report --period T1 T2 ... [--out DIR]
       the blade's power and the bed's motion: DIR/mixer.md.
+  moving.py pictures --omega W --U U --period T [--out DIR]
+      the last snapshot of each twin of the three scenes, coloured by speed (LAMMPS dump
+      image): DIR/{drum,shear,mixer}.METHOD.png.
 
 Global options (--workdir, --np, --lmp, --lmp-fibre, --tag) go before the subcommand.
 
@@ -55,8 +58,10 @@ Mixer, over the blade's last revolution:
 """
 
 import argparse
+import glob
 import math
 import os
+import shutil
 import subprocess
 import sys
 import time
@@ -341,6 +346,59 @@ def cmd_mixer_report(a):
         f.write(table + "\n")
 
 
+PICTURE_DECK = """units si
+atom_style sphere
+boundary f f f
+read_data {data}
+variable c atom sqrt(vx*vx+vy*vy+vz*vz)
+dump img all image 1 picture.*.png v_c diameter view {view} zoom {zoom} size 480 360 box no 0.0
+dump_modify img backcolor white amap 0.0 {vmax} ca 0.0 2 min blue max orange
+run 0 pre no post no
+"""
+
+
+def picture(a, d, dump, png, view, zoom, vmax):
+    """The last frame of a trajectory dump as a PNG, coloured by speed (0 .. vmax)."""
+    step, c = compare.read_frames(os.path.join(d, dump))[-1]
+    data = os.path.join(d, "picture.data")
+    lo = [c[k].min() - 1 for k in "xyz"]
+    hi = [c[k].max() + 1 for k in "xyz"]
+    with open(data, "w") as f:
+        f.write("snapshot of %s step %d\n\n%d atoms\n1 atom types\n" % (dump, step, len(c["x"])))
+        for k, (l, h) in enumerate(zip(lo, hi)):
+            f.write("%g %g %slo %shi\n" % (l, h, "xyz"[k], "xyz"[k]))
+        f.write("\nAtoms # sphere\n\n")
+        for i in range(len(c["x"])):
+            f.write("%d 1 %.6g 1 %.6g %.6g %.6g\n" % (i + 1, 2 * c["radius"][i], c["x"][i],
+                                                       c["y"][i], c["z"][i]))
+        f.write("\nVelocities\n\n")
+        for i in range(len(c["x"])):
+            f.write("%d %.6g %.6g %.6g 0 0 0\n" % (i + 1, c["vx"][i], c["vy"][i], c["vz"][i]))
+    deck = os.path.join(d, "in.picture")
+    with open(deck, "w") as f:
+        f.write(PICTURE_DECK.format(data=data, view=view, zoom=zoom, vmax=vmax))
+    for old in glob.glob(os.path.join(d, "picture.*.png")):
+        os.remove(old)
+    rc = subprocess.call([a.lmp, "-in", deck, "-log", "none", "-screen", "none"], cwd=d)
+    made = glob.glob(os.path.join(d, "picture.*.png"))
+    if rc != 0 or not made:
+        compare.die("dump image failed for " + dump)
+    shutil.move(made[0], png)
+    print("wrote", png)
+
+
+def cmd_pictures(a):
+    os.makedirs(a.out, exist_ok=True)
+    for m in METHODS:
+        picture(a, run_dir(a.drum_workdir, a.omega), "drum.%s.%g.traj" % (m, a.omega),
+                os.path.join(a.out, "drum.%s.png" % m), "90 -90", 1.4, a.omega * R_DRUM)
+        picture(a, shear_dir(a.workdir, a.U), "shear.%s.traj" % m,
+                os.path.join(a.out, "shear.%s.png" % m), "80 -90", 1.3, a.U)
+        picture(a, mixer_dir(a.workdir, a.period), "mixer.%s.traj" % m,
+                os.path.join(a.out, "mixer.%s.png" % m), "60 -60", 1.4,
+                2 * math.pi * 4.0 / a.period)
+
+
 def main():
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0],
                                 formatter_class=argparse.RawDescriptionHelpFormatter,
@@ -378,11 +436,17 @@ def main():
     q = sub.add_parser("mixer-report")
     q.add_argument("--period", type=float, nargs="+", required=True)
     q.add_argument("--out", default=out)
+    q = sub.add_parser("pictures")
+    q.add_argument("--omega", type=float, default=0.3)
+    q.add_argument("--U", type=float, default=2.0)
+    q.add_argument("--period", type=float, default=4.0)
+    q.add_argument("--drum-workdir", default="/tmp/scenes/drum")
+    q.add_argument("--out", default=os.path.join(REPO, "examples", "pictures"))
     a = p.parse_args()
     a.lmp_fibre = os.path.abspath(a.lmp_fibre)
     {"drum-run": cmd_drum_run, "drum-report": cmd_drum_report, "shear-run": cmd_shear_run,
      "shear-report": cmd_shear_report, "mixer-run": cmd_mixer_run,
-     "mixer-report": cmd_mixer_report}[a.cmd](a)
+     "mixer-report": cmd_mixer_report, "pictures": cmd_pictures}[a.cmd](a)
 
 
 if __name__ == "__main__":

@@ -22,7 +22,8 @@ namespace {
 // ||lambda||^2 (local). The rows of G are applied in their structured form (contact_rows.hpp).
 template <int R>
 void sweep(const ContactSystem &sys, const Cones &cones, const Vector &b,
-           const std::vector<Vec6> &inv_scale, Vector &lambda, Vector &dv, double norms[2])
+           const std::vector<Vec6> &inv_scale, const std::vector<int> &owners, Vector &lambda,
+           Vector &dv, double norms[2])
 {
   const int nc = sys.num_contacts();
   const int *pairs = sys.body_pairs();
@@ -31,7 +32,11 @@ void sweep(const ContactSystem &sys, const Cones &cones, const Vector &b,
   double *l = lambda.data(), *w = dv.data();
   for (int c = 0; c < nc; ++c) {
     const double *q = kin + 15 * std::size_t(c);
-    const int ia = pairs[2 * std::size_t(c)], ib = pairs[2 * std::size_t(c) + 1];
+    int ia = pairs[2 * std::size_t(c)], ib = pairs[2 * std::size_t(c) + 1];
+    if (!owners.empty()) { // a periodic image moves with its body
+      ia = owners[ia];
+      if (ib >= 0) ib = owners[ib];
+    }
     double *wa = w + 6 * std::size_t(ia), *wb = ib >= 0 ? w + 6 * std::size_t(ib) : nullptr;
     double u[6], old[6], delta[6] = {0, 0, 0, 0, 0, 0};
     contact_velocity<R>(q, q + 9, q + 12, wa, wb, u);
@@ -80,9 +85,9 @@ PgsResult pgs(const ContactSystem &sys, const Exchange &ex, const Cones &cones, 
     lambda_start = lambda;
     double norms[2] = {0, 0}; // ||change||^2, ||lambda||^2
     if (rows == 6)
-      sweep<6>(sys, cones, b, inv_scale, lambda, dv, norms);
+      sweep<6>(sys, cones, b, inv_scale, ex.local_owners(), lambda, dv, norms);
     else
-      sweep<3>(sys, cones, b, inv_scale, lambda, dv, norms);
+      sweep<3>(sys, cones, b, inv_scale, ex.local_owners(), lambda, dv, norms);
     // Every process's updates on every body: the sum of the local changes, owners and ghosts.
     moved = dv - dv_start;
     ex.reverse_sum(moved);

@@ -23,6 +23,14 @@ class Exchange {
 
   // Exclusive prefix sum over processes in rank order (0 on the first).
   virtual long exclusive_prefix_sum(long local) const = 0;
+  // For every local body, the body of this process that holds its velocity: itself, or for a
+  // ghost that is a periodic image of a body owned here, that body. Gauss-Seidel sweeps update
+  // it in place (the images of one body must not relax apart within a sweep). Empty: itself.
+  virtual const std::vector<int> &local_owners() const
+  {
+    static const std::vector<int> none;
+    return none;
+  }
 
   double sum(double x) const
   {
