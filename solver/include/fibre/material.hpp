@@ -77,10 +77,11 @@ FrictionParams contact_friction(const PairCoefficients &p, double r_eff, double 
 // pair's elastic laws at the reference load F = max(the contact's last normal force, the law's
 // force at its overlap). Normal row: the secant compliance d(F) / F, so that a contact at rest
 // under a steady load overlaps by the law's d(F) and a native state at equilibrium is one here
-// too; it is marked `elastic` (its gap term is the law's force, not bounded). Tangential, twisting and rolling rows: 1 / the law's spring at the contact radius a of
-// d(F), marked `elastic` (they carry their displacement in the rhs, Contact::spring). Rows
-// without a spring, and every row of a contact with F = 0 (new, not overlapping), keep `rigid`
-// (the automatic compliance). Returns false when p has no normal law.
+// too; it is marked `elastic` (its gap term is the law's force, not bounded). Tangential, twisting
+// and rolling rows: 1 / the law's spring at the contact radius a of d(F), marked `elastic` (they
+// carry their displacement in the rhs, Contact::spring). Rows without a spring, and every row of a
+// contact with F = 0 (new, not overlapping), keep `rigid` (the automatic compliance). Returns false
+// when p has no normal law.
 bool material_compliance(const PairCoefficients &p, double r_eff, double overlap, double last_force,
                          const std::array<double, kMaxRows> &rigid,
                          std::array<double, kMaxRows> &eps, std::array<bool, kMaxRows> &elastic);
