@@ -79,12 +79,22 @@ METHODS = ("native", "fibre")
 R_DRUM = 8.0  # scene.drum's default radius
 
 
-def run_dir(work, omega, tag=None):
-    return os.path.join(work, "drum.%g%s" % (omega, "." + tag if tag else ""))
+def scene_dir(work, scene, value, tag=None):
+    """WORKDIR/SCENE.VALUE[.TAG]: the run directory of one speed (or period) of a scene."""
+    return os.path.join(work, "%s.%g%s" % (scene, value, "." + tag if tag else ""))
 
 
-def log_name(method, omega):
-    return "log.drum.%s.%g" % (method, omega)
+def scene_log(scene, method, value):
+    return "log.%s.%s.%g" % (scene, method, value)
+
+
+def write_table(a, name, rows):
+    """Prints a markdown table and writes it to OUT/NAME.md."""
+    table = "\n".join(rows)
+    print(table)
+    os.makedirs(a.out, exist_ok=True)
+    with open(os.path.join(a.out, name + ".md"), "w") as f:
+        f.write(table + "\n")
 
 
 def run_twins(a, scene, d, log_of, variables):
@@ -108,7 +118,8 @@ def run_twins(a, scene, d, log_of, variables):
 
 def cmd_drum_run(a):
     for omega in a.omega:
-        run_twins(a, "drum", run_dir(a.workdir, omega, a.tag), lambda m: log_name(m, omega),
+        run_twins(a, "drum", scene_dir(a.workdir, "drum", omega, a.tag),
+                  lambda m: scene_log("drum", m, omega),
                   [("omega", omega), ("revs", a.revs)])
 
 
@@ -159,8 +170,8 @@ def layer_profile(frames, fits, strip=1.5, dz=0.5):
 
 
 def measure(a, omega, method):
-    d = run_dir(a.workdir, omega, a.tag)
-    blocks = compare.parse_thermo(os.path.join(d, log_name(method, omega)))
+    d = scene_dir(a.workdir, "drum", omega, a.tag)
+    blocks = compare.parse_thermo(os.path.join(d, scene_log("drum", method, omega)))
     sim = compare.sim_seconds(blocks)
     res = {"wall_per_s": compare.wall_seconds(blocks) / sim, "atoms": int(blocks[-1]["Atoms"][-1])}
     res["rmax"] = float(max(b["c_rmax"].max() for b in blocks[-1:]))
@@ -193,11 +204,7 @@ def cmd_drum_report(a):
             rows.append("| %g | %.3f | %s | %.1f | %.1f | %.2f | %.3f | %.2f | %s |" % (
                 omega, omega ** 2 * R_DRUM / compare.G, m, r["angle"], r["angle_sd"],
                 r["layer"], r["rmax"], r["wall_per_s"], ratio))
-    table = "\n".join(rows)
-    print(table)
-    os.makedirs(a.out, exist_ok=True)
-    with open(os.path.join(a.out, "drum.md"), "w") as f:
-        f.write(table + "\n")
+    write_table(a, "drum", rows)
     plot(results, os.path.join(a.out, "drum.profiles.png"))
 
 
@@ -235,23 +242,16 @@ def plot(results, path):
     print("wrote", path)
 
 
-def shear_dir(work, U, tag=None):
-    return os.path.join(work, "shear.%g%s" % (U, "." + tag if tag else ""))
-
-
-def shear_log(method, U):
-    return "log.shear.%s.%g" % (method, U)
-
-
 def cmd_shear_run(a):
     for U in a.U:
-        run_twins(a, "shear", shear_dir(a.workdir, U, a.tag), lambda m: shear_log(m, U),
+        run_twins(a, "shear", scene_dir(a.workdir, "shear", U, a.tag),
+                  lambda m: scene_log("shear", m, U),
                   [("U", U), ("tshear", a.tshear)])
 
 
 def measure_shear(a, U, method, Hc=5.0, mean_d=0.75):
-    blocks = compare.parse_thermo(os.path.join(shear_dir(a.workdir, U, a.tag),
-                                               shear_log(method, U)))
+    blocks = compare.parse_thermo(os.path.join(scene_dir(a.workdir, "shear", U, a.tag),
+                                               scene_log("shear", method, U)))
     b = blocks[-1]  # the shear run
     t = b["Time"] - b["Time"][0]
     keep = t >= a.tskip
@@ -280,30 +280,18 @@ def cmd_shear_report(a):
                 U, m, r["mu"], r["mu_sem"], r["p"], r["I"], r["wall_per_s"], ratio))
         rows.append("| %g | fibre / native | %.3f | %.2f | | | |" % (
             U, R["fibre"]["mu"] / R["native"]["mu"], R["fibre"]["p"] / R["native"]["p"]))
-    table = "\n".join(rows)
-    print(table)
-    os.makedirs(a.out, exist_ok=True)
-    with open(os.path.join(a.out, "shear.md"), "w") as f:
-        f.write(table + "\n")
-
-
-def mixer_dir(work, period, tag=None):
-    return os.path.join(work, "mixer.%g%s" % (period, "." + tag if tag else ""))
-
-
-def mixer_log(method, period):
-    return "log.mixer.%s.%g" % (method, period)
+    write_table(a, "shear", rows)
 
 
 def cmd_mixer_run(a):
     for period in a.period:
-        run_twins(a, "mixer", mixer_dir(a.workdir, period, a.tag),
-                  lambda m: mixer_log(m, period), [("period", period), ("revs", a.revs)])
+        run_twins(a, "mixer", scene_dir(a.workdir, "mixer", period, a.tag),
+                  lambda m: scene_log("mixer", m, period), [("period", period), ("revs", a.revs)])
 
 
 def measure_mixer(a, period, method):
-    d = mixer_dir(a.workdir, period, a.tag)
-    blocks = compare.parse_thermo(os.path.join(d, mixer_log(method, period)))
+    d = scene_dir(a.workdir, "mixer", period, a.tag)
+    blocks = compare.parse_thermo(os.path.join(d, scene_log("mixer", method, period)))
     rest, b = blocks[-2], blocks[-1]
     t = b["Time"]
     last = t >= t[-1] - period - 1e-9
@@ -339,11 +327,7 @@ def cmd_mixer_report(a):
         rows.append("| %g | | fibre / native | %.3f | %.3f | %.3f | | | |" % (
             period, R["fibre"]["power"] / R["native"]["power"], R["fibre"]["ke"] / R["native"]["ke"],
             R["fibre"]["lift"] / R["native"]["lift"]))
-    table = "\n".join(rows)
-    print(table)
-    os.makedirs(a.out, exist_ok=True)
-    with open(os.path.join(a.out, "mixer.md"), "w") as f:
-        f.write(table + "\n")
+    write_table(a, "mixer", rows)
 
 
 PICTURE_DECK = """units si
@@ -390,11 +374,11 @@ def picture(a, d, dump, png, view, zoom, vmax):
 def cmd_pictures(a):
     os.makedirs(a.out, exist_ok=True)
     for m in METHODS:
-        picture(a, run_dir(a.drum_workdir, a.omega), "drum.%s.%g.traj" % (m, a.omega),
+        picture(a, scene_dir(a.drum_workdir, "drum", a.omega), "drum.%s.%g.traj" % (m, a.omega),
                 os.path.join(a.out, "drum.%s.png" % m), "90 -90", 1.4, a.omega * R_DRUM)
-        picture(a, shear_dir(a.workdir, a.U), "shear.%s.traj" % m,
+        picture(a, scene_dir(a.workdir, "shear", a.U), "shear.%s.traj" % m,
                 os.path.join(a.out, "shear.%s.png" % m), "80 -90", 1.3, a.U)
-        picture(a, mixer_dir(a.workdir, a.period), "mixer.%s.traj" % m,
+        picture(a, scene_dir(a.workdir, "mixer", a.period), "mixer.%s.traj" % m,
                 os.path.join(a.out, "mixer.%s.png" % m), "60 -60", 1.4,
                 2 * math.pi * 4.0 / a.period)
 
