@@ -88,6 +88,13 @@ def scene_log(scene, method, value):
     return "log.%s.%s.%g" % (scene, method, value)
 
 
+def speed_ratio(R, method):
+    """The table's last column: native over fibre wall time, on the fibre row only."""
+    if method != "fibre":
+        return ""
+    return "**%.2f**" % (R["native"]["wall_per_s"] / R["fibre"]["wall_per_s"])
+
+
 def write_table(a, name, rows):
     """Prints a markdown table and writes it to OUT/NAME.md."""
     table = "\n".join(rows)
@@ -199,8 +206,7 @@ def cmd_drum_report(a):
         results[omega] = R
         for m in METHODS:
             r = R[m]
-            ratio = ("**%.2f**" % (R["native"]["wall_per_s"] / r["wall_per_s"])
-                     if m == "fibre" else "")
+            ratio = speed_ratio(R, m)
             rows.append("| %g | %.3f | %s | %.1f | %.1f | %.2f | %.3f | %.2f | %s |" % (
                 omega, omega ** 2 * R_DRUM / compare.G, m, r["angle"], r["angle_sd"],
                 r["layer"], r["rmax"], r["wall_per_s"], ratio))
@@ -274,8 +280,7 @@ def cmd_shear_report(a):
         R = {m: measure_shear(a, U, m) for m in METHODS}
         for m in METHODS:
             r = R[m]
-            ratio = ("**%.2f**" % (R["native"]["wall_per_s"] / r["wall_per_s"])
-                     if m == "fibre" else "")
+            ratio = speed_ratio(R, m)
             rows.append("| %g | %s | %.3f +- %.3f | %.1f | %.3f | %.2f | %s |" % (
                 U, m, r["mu"], r["mu_sem"], r["p"], r["I"], r["wall_per_s"], ratio))
         rows.append("| %g | fibre / native | %.3f | %.2f | | | |" % (
@@ -319,8 +324,7 @@ def cmd_mixer_report(a):
         R = {m: measure_mixer(a, period, m) for m in METHODS}
         for m in METHODS:
             r = R[m]
-            ratio = ("**%.2f**" % (R["native"]["wall_per_s"] / r["wall_per_s"])
-                     if m == "fibre" else "")
+            ratio = speed_ratio(R, m)
             rows.append("| %g | %.2f | %s | %.0f | %.1f | %.3f | %.3f | %.2f | %s |" % (
                 period, 2 * math.pi * 4.0 / period, m, r["power"], r["ke"], r["lift"],
                 r["overlap"], r["wall_per_s"], ratio))
@@ -395,31 +399,20 @@ def main():
     p.add_argument("--tag", default=None)
     sub = p.add_subparsers(dest="cmd", required=True)
     out = os.path.join(HERE, "results")
-    r = sub.add_parser("drum-run")
-    r.add_argument("--omega", type=float, nargs="+", required=True)
-    r.add_argument("--method", choices=("fibre", "native", "both"), default="both")
-    r.add_argument("--revs", type=float, default=2.0)
-    r.add_argument("--var", nargs=2, action="append", metavar=("NAME", "VALUE"))
-    q = sub.add_parser("drum-report")
-    q.add_argument("--omega", type=float, nargs="+", required=True)
-    q.add_argument("--out", default=out)
-    r = sub.add_parser("shear-run")
-    r.add_argument("--U", type=float, nargs="+", required=True)
-    r.add_argument("--method", choices=("fibre", "native", "both"), default="both")
-    r.add_argument("--tshear", type=float, default=10.0)
-    r.add_argument("--var", nargs=2, action="append", metavar=("NAME", "VALUE"))
-    q = sub.add_parser("shear-report")
-    q.add_argument("--U", type=float, nargs="+", required=True)
-    q.add_argument("--tskip", type=float, default=3.0, help="seconds of shear left out")
-    q.add_argument("--out", default=out)
-    r = sub.add_parser("mixer-run")
-    r.add_argument("--period", type=float, nargs="+", required=True)
-    r.add_argument("--method", choices=("fibre", "native", "both"), default="both")
-    r.add_argument("--revs", type=float, default=3.0)
-    r.add_argument("--var", nargs=2, action="append", metavar=("NAME", "VALUE"))
-    q = sub.add_parser("mixer-report")
-    q.add_argument("--period", type=float, nargs="+", required=True)
-    q.add_argument("--out", default=out)
+    # per scene: its swept variable, and the run's own option (name, default)
+    for scene, swept, run_opt in (("drum", "--omega", ("--revs", 2.0)),
+                                  ("shear", "--U", ("--tshear", 10.0)),
+                                  ("mixer", "--period", ("--revs", 3.0))):
+        r = sub.add_parser(scene + "-run")
+        r.add_argument(swept, type=float, nargs="+", required=True)
+        r.add_argument("--method", choices=("fibre", "native", "both"), default="both")
+        r.add_argument(run_opt[0], type=float, default=run_opt[1])
+        r.add_argument("--var", nargs=2, action="append", metavar=("NAME", "VALUE"))
+        q = sub.add_parser(scene + "-report")
+        q.add_argument(swept, type=float, nargs="+", required=True)
+        q.add_argument("--out", default=out)
+        if scene == "shear":
+            q.add_argument("--tskip", type=float, default=3.0, help="seconds of shear left out")
     q = sub.add_parser("pictures")
     q.add_argument("--omega", type=float, default=0.3)
     q.add_argument("--U", type=float, default=2.0)
