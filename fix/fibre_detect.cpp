@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 
 #include "atom.h"
 #include "domain.h"
@@ -21,8 +22,7 @@ namespace {
 
 bool is_combined(const Region *region)
 {
-  const std::string style = region->style;
-  return style == "union" || style == "intersect";
+  return std::strcmp(region->style, "union") == 0 || std::strcmp(region->style, "intersect") == 0;
 }
 
 // The sub-region that made contact `iwall` of a union or intersect, recursively (the region

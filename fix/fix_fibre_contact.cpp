@@ -454,12 +454,14 @@ void FixFibreContact::final_integrate()
   update_velocities(res.dv.size() > 0 ? &res.dv : nullptr);
   if (evflag) // this step's virial is wanted (post_force)
     tally_virial(sys, res.lambda.size() ? res.lambda : fibre::Vector::Zero(sys.contact_dofs()));
-  // the elastic rows' springs (compliance material; collective, so on every process)
+  // the elastic rows' springs (compliance material) and the energy the moving walls put in and
+  // the contacts take out, both from the velocities after the step (collective: every process)
   std::vector<std::array<double, fibre::kMaxRows>> springs;
-  if (any && model.compliance.material)
-    springs = fibre::advance_springs(sys, *exchange_, res.lambda);
-  // the energy the moving walls put in and the contacts take out (collective)
-  if (any) output_->add_work(fibre::contact_work(sys, *exchange_, res.lambda));
+  if (any) {
+    const fibre::Vector v_plus = fibre::velocities_after(sys, *exchange_, res.lambda);
+    if (model.compliance.material) springs = fibre::advance_springs(sys, v_plus, res.lambda);
+    output_->add_work(fibre::contact_work(sys, v_plus, res.lambda));
+  }
   overflow_count_ += history_.store(found, res.lambda, model.rows, dtv_, atom->nlocal,
                                     springs.empty() ? nullptr : &springs);
 

@@ -103,9 +103,9 @@ Vector velocities_after(const ContactSystem &sys, const Exchange &ex, const Vect
   return v_plus;
 }
 
-ContactWork contact_work(const ContactSystem &sys, const Exchange &ex, const Vector &lambda)
+ContactWork contact_work(const ContactSystem &sys, const Vector &v_plus, const Vector &lambda)
 {
-  const Vector v_mid = 0.5 * (body_velocities(sys) + velocities_after(sys, ex, lambda));
+  const Vector v_mid = 0.5 * (body_velocities(sys) + v_plus);
   ContactWork work;
   if (lambda.size() != sys.contact_dofs()) return work;
   Vector Gv;
@@ -122,13 +122,13 @@ ContactWork contact_work(const ContactSystem &sys, const Exchange &ex, const Vec
   return work;
 }
 
-std::vector<std::array<double, kMaxRows>> advance_springs(const ContactSystem &sys,
-                                                          const Exchange &ex, const Vector &lambda)
+std::vector<std::array<double, kMaxRows>>
+advance_springs(const ContactSystem &sys, const Vector &v_plus, const Vector &lambda)
 {
   const int rows = sys.rows(), nc = sys.num_contacts();
   std::vector<std::array<double, kMaxRows>> springs(nc);
   Vector Gv;
-  g_apply(sys, velocities_after(sys, ex, lambda), Gv);
+  g_apply(sys, v_plus, Gv);
   const Cones cones(sys);
   const double h = sys.params().h;
   for (int c = 0; c < nc; ++c) {

@@ -73,7 +73,8 @@ class StepSolver {
   const Cones cones_;
   std::vector<ContactState> state_;
   const std::vector<unsigned char> all_rows_;
-  Vector b_full_; // the rhs with every row active and no fixed impulses
+  Vector b_full_;                // the rhs with every row active and no fixed impulses
+  std::vector<Vec6> row_scales_; // the sweeps' and residuals' row scales, every row active
   StopReason last_reason_ = StopReason::converged;
 };
 
@@ -265,7 +266,7 @@ void StepSolver::project(Vector &lambda) const
 void StepSolver::finish(Vector &lambda, StepResult &res) const
 {
   const auto t_sweep = Clock::now();
-  const std::vector<Vec6> scale = row_scales(sys_);
+  const std::vector<Vec6> &scale = row_scales_;
   res.complementarity = complementarity(sys_, ex_, cones_, b_full_, lambda, scale);
   res.error_estimate = res.complementarity;
   if (opt_.sweeps > 0 && res.complementarity > opt_.sweep_tol) {
@@ -373,13 +374,14 @@ StepResult StepSolver::run(const Vector *warm)
   StepResult res;
   sys_.set_row_mask(all_rows_);
   b_full_ = spook_rhs(sys_);
+  row_scales_ = row_scales(sys_);
   Vector lambda = initial_impulses(warm);
   // The projected warm start and its residual: the step never ends worse than the sweeps
   // alone would leave it from there.
   Vector start = lambda;
   project(start);
   const double start_residual =
-      sweeps_only() ? 0.0 : complementarity(sys_, ex_, cones_, b_full_, start, row_scales(sys_));
+      sweeps_only() ? 0.0 : complementarity(sys_, ex_, cones_, b_full_, start, row_scales_);
   if (!sweeps_only()) active_set_loop(lambda, res);
   // Feasible impulses, then projected Gauss-Seidel sweeps while they are not accurate enough.
   // (Projecting an unsettled pass alone could zero a tensile impulse that balances large

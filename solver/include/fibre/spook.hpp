@@ -34,20 +34,20 @@ Vector velocities_after(const ContactSystem &sys, const Exchange &ex, const Vect
 // the wall's velocity; `dissipation` is lambda . the relative velocity at the step's mean
 // velocity (v + v+) / 2, with a minus sign: the energy the contacts take out (dissipated, or
 // stored in compliant rows). Their kinetic energy change is wall_work - dissipation, exactly,
-// since the impulses change v linearly. Collective (velocities_after).
+// since the impulses change v linearly. v_plus: velocities_after(sys, ex, lambda).
 struct ContactWork {
   double wall_work = 0.0;
   double dissipation = 0.0;
 };
-ContactWork contact_work(const ContactSystem &sys, const Exchange &ex, const Vector &lambda);
+ContactWork contact_work(const ContactSystem &sys, const Vector &v_plus, const Vector &lambda);
 
 // The elastic rows' displacements at the step's end, rows per contact in each contact's frame
 // (Contact::spring): spring + h G v+ on every elastic row, with v+ = v + h M^-1 f + M^-1 G^T
 // lambda the velocities after the step, ghosts included. On a cone at its limit the spring
 // keeps only the displacement whose force the cone carries, -eps lambda / h (LAMMPS's history
 // rescaling), so that a sliding contact snaps back by its elastic part only. Zero on rows that
-// are not elastic. Collective (velocity_change): every process calls it.
-std::vector<std::array<double, kMaxRows>> advance_springs(const ContactSystem &sys,
-                                                          const Exchange &ex, const Vector &lambda);
+// are not elastic. v_plus: velocities_after(sys, ex, lambda).
+std::vector<std::array<double, kMaxRows>>
+advance_springs(const ContactSystem &sys, const Vector &v_plus, const Vector &lambda);
 
 } // namespace fibre
