@@ -8,6 +8,8 @@ packages=(
   cmake g++ make pkg-config clang libclang-rt-14-dev clang-format
   # LAMMPS with headers, cmake config and official example decks
   lammps liblammps-dev lammps-examples
+  # LIGGGHTS with headers and its tutorial decks (the LIGGGHTS front end)
+  liggghts libliggghts-dev liggghts-doc
   # MPI, linear algebra, direct solver
   openmpi-bin libopenmpi-dev libeigen3-dev libmumps-dev
   # formatting (LAMMPS headers need fmt, Debian omits the bundled copy)

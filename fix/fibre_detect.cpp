@@ -2,140 +2,25 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstring>
 
 #include "atom.h"
-#include "domain.h"
 #include "error.h"
+#include "host.h"
 #include "force.h"
 #include "lammps_exchange.h"
 #include "neigh_list.h"
 #include "neighbor.h"
 #include "pair.h"
-#include "region.h"
 
 using namespace LAMMPS_NS;
 
 namespace fibre_lmp {
 
-namespace {
-
-bool is_combined(const Region *region)
-{
-  return std::strcmp(region->style, "union") == 0 || std::strcmp(region->style, "intersect") == 0;
-}
-
-// The sub-region that made contact `iwall` of a union or intersect, recursively (the region
-// itself when it is not combined). LAMMPS numbers a combined region's contacts by sub-region:
-// with `side in` the sub-region's own number plus the cmax of the sub-regions before it, with
-// `side out` the sub-region's index in the list.
-Region *contact_owner(Domain *domain, Region *region, int iwall)
-{
-  while (is_combined(region)) {
-    Region *owner = nullptr;
-    if (!region->interior) {
-      if (iwall < 0 || iwall >= region->nregion) return region;
-      owner = domain->regions[region->list[iwall]];
-      iwall = 0;
-    } else {
-      for (int i = 0; i < region->nregion && !owner; ++i) {
-        Region *sub = domain->regions[region->list[i]];
-        if (iwall < sub->cmax)
-          owner = sub;
-        else
-          iwall -= sub->cmax;
-      }
-      if (!owner) return region;
-    }
-    region = owner;
-  }
-  return region;
-}
-
-// A moving (sub-)region's surface velocity at point p and its angular velocity, from its
-// displacement and rotation over the last step (set_velocity, LAMMPS's differencing).
-void surface_velocity(const Region *region, const double *p, fibre::Vec3 &v, fibre::Vec3 &w)
-{
-  v = region->moveflag ? fibre::Vec3(region->v[0], region->v[1], region->v[2])
-                       : fibre::Vec3::Zero();
-  w = fibre::Vec3::Zero();
-  if (!region->rotateflag) return;
-  w = fibre::Vec3(region->omega[0], region->omega[1], region->omega[2]);
-  const fibre::Vec3 arm(p[0] - region->rpoint[0], p[1] - region->rpoint[1],
-                        p[2] - region->rpoint[2]);
-  v += w.cross(arm);
-}
-
-// A bound of the surface speed of a moving region (and of its moving sub-regions) within the
-// sphere's reach: translation plus rotation at the sphere's distance from the axis point.
-double speed_bound(Domain *domain, const Region *region, const double *x, double radius)
-{
-  if (is_combined(region)) {
-    double most = 0.0;
-    for (int i = 0; i < region->nregion; ++i)
-      most = std::max(most, speed_bound(domain, domain->regions[region->list[i]], x, radius));
-    return most;
-  }
-  if (!region->dynamic) return 0.0;
-  double speed = region->moveflag
-                     ? std::sqrt(region->v[0] * region->v[0] + region->v[1] * region->v[1] +
-                                 region->v[2] * region->v[2])
-                     : 0.0;
-  if (region->rotateflag) {
-    const double w =
-        std::sqrt(region->omega[0] * region->omega[0] + region->omega[1] * region->omega[1] +
-                  region->omega[2] * region->omega[2]);
-    const double dx = x[0] - region->rpoint[0], dy = x[1] - region->rpoint[1],
-                 dz = x[2] - region->rpoint[2];
-    speed += w * (std::sqrt(dx * dx + dy * dy + dz * dz) + radius);
-  }
-  return speed;
-}
-
-} // namespace
-
-LammpsDetection::LammpsDetection(LAMMPS *lmp, int groupbit, LammpsExchange &exchange)
-    : Pointers(lmp), groupbit_(groupbit), exchange_(exchange)
-{
-}
-
 void LammpsDetection::init_walls(const std::vector<fibre::WallSpec> &walls)
 {
   walls_ = walls;
-  regions_.assign(walls.size(), -1);
-  for (std::size_t w = 0; w < walls.size(); ++w) {
-    if (walls[w].kind != fibre::WallKind::region) continue;
-    const std::string &id = walls[w].region_id;
-    regions_[w] = domain->find_region(id);
-    if (regions_[w] < 0)
-      error->all(FLERR,
-                 "Region ID '" + id + "' for fix fibre_contact 'wall region' does not exist");
-    Region *region = domain->regions[regions_[w]];
-    // A union or intersect moves with its sub-regions (contact_owner); with `side out` LAMMPS
-    // numbers the contacts of a nested union or intersect by its index only.
-    if (is_combined(region) && region->dynamic && !region->interior)
-      for (int i = 0; i < region->nregion; ++i) {
-        const Region *sub = domain->regions[region->list[i]];
-        if (is_combined(sub) && sub->dynamic)
-          error->all(FLERR, "Fix fibre_contact 'wall region " + id + "': a moving " + sub->style +
-                                " inside a region with 'side out' is not "
-                                "supported; list its sub-regions in " +
-                                id + " instead");
-      }
-    if (region->varshape)
-      error->all(FLERR, "Fix fibre_contact 'wall region " + id +
-                            "': a region whose shape changes over time (variable radius) is "
-                            "not supported; 'move' and 'rotate' are");
-  }
-}
-
-void LammpsDetection::start_moving_walls()
-{
-  for (int r : regions_) {
-    if (r < 0 || !domain->regions[r]->dynamic) continue;
-    domain->regions[r]->prematch();
-    domain->regions[r]->set_velocity();
-  }
+  for (int w = 0; w < static_cast<int>(walls.size()); ++w)
+    if (!walls[w].is_plane()) init_host_wall(w);
 }
 
 std::vector<fibre::Body> LammpsDetection::bodies()
@@ -326,7 +211,7 @@ void LammpsDetection::wall_contacts(const std::vector<fibre::Body> &bodies, doub
   const int nowned = exchange_.num_owned();
   const double skin = neighbor->skin;
   for (int w = 0; w < static_cast<int>(walls_.size()); ++w) {
-    if (walls_[w].kind != fibre::WallKind::region) {
+    if (walls_[w].is_plane()) {
       for (int k = 0; k < nowned; ++k) {
         fibre::PlaneHit hits[2];
         const int n = fibre::plane_hits(walls_[w], bodies[k], skin, hits, wall_time_);
@@ -337,31 +222,7 @@ void LammpsDetection::wall_contacts(const std::vector<fibre::Body> &bodies, doub
       }
       continue;
     }
-    Region *region = domain->regions[regions_[w]];
-    region->prematch();
-    // the surface velocity of a moving region: its displacement and rotation over the last
-    // step (LAMMPS's set_velocity, once per step whoever calls it)
-    const bool moving = region->dynamic;
-    if (moving) region->set_velocity();
-    for (int k = 0; k < nowned; ++k) {
-      const fibre::Body &b = bodies[k];
-      const double speed = moving ? speed_bound(domain, region, b.x.data(), b.radius) : 0.0;
-      const int nc =
-          region->surface(b.x[0], b.x[1], b.x[2], fibre::region_cutoff(b, h, damping, skin, speed));
-      for (int c = 0; c < nc; ++c) {
-        const Region::Contact &rc = region->contact[c];
-        if (!(rc.r > 0.0)) continue;
-        const fibre::Vec3 n(rc.delx / rc.r, rc.dely / rc.r, rc.delz / rc.r);
-        // the surface point's velocity, from the (sub-)region it belongs to
-        fibre::Vec3 wall_v = fibre::Vec3::Zero(), wall_omega = fibre::Vec3::Zero();
-        if (moving) {
-          const double p[3] = {b.x[0] - rc.delx, b.x[1] - rc.dely, b.x[2] - rc.delz};
-          surface_velocity(contact_owner(domain, region, rc.iwall), p, wall_v, wall_omega);
-        }
-        add_wall_contact(bodies, k, n, rc.r, w, std::min(rc.iwall, fibre::kWallKeyStride - 1),
-                         wall_v, wall_omega, h, damping, found);
-      }
-    }
+    host_wall_contacts(w, bodies, h, damping, found);
   }
 }
 

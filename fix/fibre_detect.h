@@ -1,9 +1,12 @@
-// Contact detection for fix fibre_contact on LAMMPS data: the group's atoms as bodies (owned
-// ones sorted by tag, then ghosts), sphere pairs from the granular pair style's neighbour
-// list, spheres outside the group as fixed obstacles, plane and region walls. The criteria
-// and plane geometry are the library's (fibre/detection.hpp).
+// Contact detection for fix fibre_contact on LAMMPS or LIGGGHTS data: the group's atoms as
+// bodies (owned ones sorted by tag, then ghosts), sphere pairs from the granular pair style's
+// neighbour list, spheres outside the group as fixed obstacles, plane walls, and the host's
+// own walls: LAMMPS regions (fix/region_walls.cpp) or LIGGGHTS meshes
+// (liggghts/mesh_walls.cpp). The criteria and geometry are the library's (fibre/detection.hpp,
+// fibre/mesh.hpp).
 #pragma once
 
+#include <memory>
 #include <vector>
 
 #include "fibre/detection.hpp"
@@ -16,8 +19,9 @@ class LammpsExchange;
 class LammpsDetection : protected LAMMPS_NS::Pointers {
  public:
   LammpsDetection(LAMMPS_NS::LAMMPS *lmp, int groupbit, LammpsExchange &exchange);
+  ~LammpsDetection() override;
 
-  // Resolves region walls (region IDs to regions); call from init().
+  // Resolves the host's walls (region or mesh IDs); call from init().
   void init_walls(const std::vector<fibre::WallSpec> &walls);
   // At a run's setup: moving regions record their present position, so that the first step's
   // surface velocity is that step's displacement (not the one since the region was defined).
@@ -48,12 +52,19 @@ class LammpsDetection : protected LAMMPS_NS::Pointers {
 
   double kick(int body) const { return kick_.empty() ? 0.0 : kick_[body]; }
 
+  // The host's walls, one source file per host: regions (LAMMPS) or meshes (LIGGGHTS); the
+  // other host's kind is an error at init.
+  struct HostWalls;
+  void init_host_wall(int wall);
+  void host_wall_contacts(int wall, const std::vector<fibre::Body> &bodies, double h,
+                          double damping, std::vector<fibre::DetectedContact> &found) const;
+
   int groupbit_;
   LammpsExchange &exchange_;
   std::vector<fibre::WallSpec> walls_;
   double wall_time_ = 0.0;
-  std::vector<double> kick_;   // per body: the speed an impact may give it this step
-  std::vector<int> regions_;   // per wall: region index, or -1
+  std::vector<double> kick_; // per body: the speed an impact may give it this step
+  std::unique_ptr<HostWalls> host_walls_;
   std::vector<int> atom_body_; // local atom -> body index, -1 if not a body
 };
 

@@ -6,6 +6,7 @@
 
 #include "comm.h"
 #include "error.h"
+#include "host.h"
 #include "fibre/system_io.hpp"
 #include "fibre/text.hpp"
 #include "memory.h"
@@ -59,11 +60,11 @@ void FibreOutput::report_solve(const fibre::StepResult &res)
 
   if (res.restarted && comm->me == 0 &&
       (last_restart_warning_ < 0 || update->ntimestep - last_restart_warning_ >= 100)) {
-    error->warning(FLERR, "Fix fibre_contact: at step " +
-                              std::to_string(static_cast<long long>(update->ntimestep)) +
-                              " the linear pass left the impulses worse than the warm start; "
-                              "the sweeps restarted from the warm start (complementarity " +
-                              fibre::format_g(res.complementarity) + ")");
+    warn(error, FLERR,
+         "Fix fibre_contact: at step " + std::to_string(static_cast<long long>(update->ntimestep)) +
+             " the linear pass left the impulses worse than the warm start; "
+             "the sweeps restarted from the warm start (complementarity " +
+             fibre::format_g(res.complementarity) + ")");
     last_restart_warning_ = update->ntimestep;
   }
   if (!res.converged) {
@@ -72,16 +73,16 @@ void FibreOutput::report_solve(const fibre::StepResult &res)
     const bigint step = update->ntimestep;
     if (last_warning_step_ < 0 || step - last_warning_step_ >= 100) {
       if (comm->me == 0)
-        error->warning(FLERR,
-                       "Fix fibre_contact: contact solve did not converge at step " +
-                           std::to_string(static_cast<long long>(step)) + " (" +
-                           fibre::to_string(res.reason) + ", " + std::to_string(res.iterations) +
-                           " iterations, relative "
-                           "residual " +
-                           fibre::format_g(res.rel_residual) + "); " +
-                           std::to_string(static_cast<long long>(nonconverged_since_warning_)) +
-                           " non-converged steps since the last warning, " +
-                           std::to_string(static_cast<long long>(nonconverged_total_)) + " in all");
+        warn(error, FLERR,
+             "Fix fibre_contact: contact solve did not converge at step " +
+                 std::to_string(static_cast<long long>(step)) + " (" +
+                 fibre::to_string(res.reason) + ", " + std::to_string(res.iterations) +
+                 " iterations, relative "
+                 "residual " +
+                 fibre::format_g(res.rel_residual) + "); " +
+                 std::to_string(static_cast<long long>(nonconverged_since_warning_)) +
+                 " non-converged steps since the last warning, " +
+                 std::to_string(static_cast<long long>(nonconverged_total_)) + " in all");
       last_warning_step_ = step;
       nonconverged_since_warning_ = 0;
     }
@@ -130,11 +131,12 @@ void FibreOutput::export_step(const std::string &prefix, const fibre::ContactSys
   try {
     fibre::write_system_file(base + ".sys", sys);
   } catch (std::exception &e) {
-    error->one(FLERR,
-               "Fix fibre_contact could not write export file " + base + ".sys: " + e.what());
+    fail_one(error, FLERR,
+             "Fix fibre_contact could not write export file " + base + ".sys: " + e.what());
   }
   FILE *fp = std::fopen((base + ".lambda").c_str(), "w");
-  if (!fp) error->one(FLERR, "Fix fibre_contact could not write export file " + base + ".lambda");
+  if (!fp)
+    fail_one(error, FLERR, "Fix fibre_contact could not write export file " + base + ".lambda");
   const int rows = sys.rows();
   std::fprintf(fp, "# fibre_contact impulses, step %lld, process %d: %d contacts, %d rows each\n",
                static_cast<long long>(update->ntimestep), comm->me, sys.num_contacts(), rows);
@@ -185,7 +187,7 @@ void FibreOutput::read_restart(const char *buf)
                      : list[0] == 2.0          ? V_ERROR_ESTIMATE
                                                : 0;
   if (values == 0) {
-    error->warning(FLERR, std::string("Fix fibre_contact: restart data of another format ignored"));
+    warn(error, FLERR, std::string("Fix fibre_contact: restart data of another format ignored"));
     return;
   }
   nonconverged_total_ = static_cast<bigint>(list[1]);

@@ -11,6 +11,7 @@
 
 #include "fix_fibre_contact.h"
 
+#include <algorithm>
 #include <cmath>
 #include <exception>
 #include <limits>
@@ -30,25 +31,31 @@
 #include "pair_coefficients.h"
 #include "force.h"
 #include "group.h"
+#include "host.h"
 #include "lammps_exchange.h"
 #include "modify.h"
 #include "pair.h"
 #include "update.h"
-#include "utils.h"
 
 using namespace LAMMPS_NS;
 using namespace FixConst;
+using fibre_lmp::fail;
+using fibre_lmp::fail_one;
 using fibre_lmp::FibreOutput;
+using fibre_lmp::logmesg;
+using fibre_lmp::starts_with;
+using fibre_lmp::warn;
 
 /* ---------------------------------------------------------------------- */
 
 FixFibreContact::FixFibreContact(LAMMPS *lmp, int narg, char **arg) : Fix(lmp, narg, arg)
 {
   if (!atom->radius_flag || !atom->rmass_flag || !atom->omega_flag || !atom->torque_flag)
-    error->all(FLERR, std::string("Fix fibre_contact requires atom attributes radius, rmass, "
-                                  "omega and torque (use atom_style sphere)"));
+    fail(error, FLERR,
+         std::string("Fix fibre_contact requires atom attributes radius, rmass, "
+                     "omega and torque (use atom_style sphere)"));
   if (domain->dimension != 3)
-    error->all(FLERR, std::string("Fix fibre_contact requires a 3d simulation (dimension 3)"));
+    fail(error, FLERR, std::string("Fix fibre_contact requires a 3d simulation (dimension 3)"));
 
   time_integrate = 1;
   vector_flag = 1;
@@ -67,15 +74,23 @@ FixFibreContact::FixFibreContact(LAMMPS *lmp, int narg, char **arg) : Fix(lmp, n
   create_attribute = 1;
   comm_forward = fibre_lmp::LammpsExchange::kValuesPerAtom;
   comm_reverse = fibre_lmp::LammpsExchange::kValuesPerAtom;
+#ifdef FIBRE_HOST_LIGGGHTS
+  comm->maxexchange_fix = std::max(comm->maxexchange_fix, fibre::ContactHistory::kMaxPacked);
+#else
   maxexchange = fibre::ContactHistory::kMaxPacked;
+#endif
   // the contact forces' virial enters compute pressure and compute stress/atom
+#ifdef FIBRE_HOST_LIGGGHTS
+  virial_flag = 1;
+#else
   virial_global_flag = virial_peratom_flag = 1;
   thermo_virial = 1;
+#endif
 
   try {
     settings_ = fibre::parse_settings(std::vector<std::string>(arg + 3, arg + narg));
   } catch (fibre::SettingsError &e) {
-    error->all(FLERR, std::string("Illegal fix fibre_contact command: ") + e.what());
+    fail(error, FLERR, std::string("Illegal fix fibre_contact command: ") + e.what());
   }
 
   time_origin_ = simulated_time(); // moving planes start their motion here, as fix wall/gran's
@@ -85,17 +100,17 @@ FixFibreContact::FixFibreContact(LAMMPS *lmp, int narg, char **arg) : Fix(lmp, n
 
   // per-atom warm-start storage, migrating with the atoms and written to restart files
   grow_arrays(atom->nmax);
-  atom->add_callback(Atom::GROW);
-  atom->add_callback(Atom::RESTART);
+  atom->add_callback(fibre_lmp::kGrowCallback);
+  atom->add_callback(fibre_lmp::kRestartCallback);
 
   // this fix computes every contact force: switch the pair style's forces off
   if (force->pair) {
     pair_ = force->pair;
     pair_->compute_flag = 0;
     if (comm->me == 0)
-      utils::logmesg(lmp, std::string("fix fibre_contact: switched off the force computation of "
-                                      "pair style ") +
-                              force->pair_style + " (its neighbor list is the contact graph)\n");
+      logmesg(lmp, std::string("fix fibre_contact: switched off the force computation of "
+                               "pair style ") +
+                       force->pair_style + " (its neighbor list is the contact graph)\n");
   }
 }
 
@@ -110,10 +125,12 @@ double FixFibreContact::simulated_time() const
 
 FixFibreContact::~FixFibreContact()
 {
+#ifndef FIBRE_HOST_LIGGGHTS
   if (copymode) return;
+#endif
   delete[] extlist;
-  atom->delete_callback(id, Atom::GROW);
-  atom->delete_callback(id, Atom::RESTART);
+  atom->delete_callback(id, fibre_lmp::kGrowCallback);
+  atom->delete_callback(id, fibre_lmp::kRestartCallback);
   if (pair_ && force && force->pair == pair_) pair_->compute_flag = 1;
 }
 
@@ -130,7 +147,19 @@ int FixFibreContact::setmask()
 
 void FixFibreContact::post_force(int vflag)
 {
+  start_virial(vflag);
+}
+
+void FixFibreContact::start_virial(int vflag)
+{
+#ifdef FIBRE_HOST_LIGGGHTS
+  if (vflag)
+    v_setup(vflag);
+  else
+    evflag = vflag_global = vflag_atom = 0;
+#else
   v_init(vflag);
+#endif
 }
 
 /* ----------------------------------------------------------------------
@@ -156,20 +185,23 @@ void FixFibreContact::tally_virial(const fibre::ContactSystem &sys, const fibre:
 void FixFibreContact::check_pair_style(bool at_init)
 {
   if (!force->pair)
-    error->all(FLERR, std::string("Fix fibre_contact requires a granular pair style for its "
-                                  "neighbor list, e.g. 'pair_style gran/hooke 1.0 NULL 0.0 NULL "
-                                  "0.0 0' and 'pair_coeff * *'"));
+    fail(error, FLERR,
+         std::string("Fix fibre_contact requires a granular pair style for its "
+                     "neighbor list, e.g. 'pair_style gran/hooke 1.0 NULL 0.0 NULL "
+                     "0.0 0' and 'pair_coeff * *'"));
   const std::string style = force->pair_style ? force->pair_style : "";
-  if (!utils::strmatch(style, "^gran"))
-    error->all(FLERR, "Fix fibre_contact requires a granular pair style (gran/hooke, "
-                      "gran/hooke/history, gran/hertz/history or granular) for its neighbor "
-                      "list, not pair style '" +
-                          style + "'");
+  if (!starts_with(style.c_str(), "gran"))
+    fail(error, FLERR,
+         "Fix fibre_contact requires a granular pair style (gran/hooke, "
+         "gran/hooke/history, gran/hertz/history or granular) for its neighbor "
+         "list, not pair style '" +
+             style + "'");
   if (at_init && force->pair->compute_flag)
-    error->all(FLERR, std::string("Fix fibre_contact computes every contact force itself, but the "
-                                  "pair style's force computation is on: define the pair style "
-                                  "before fix fibre_contact and do not use 'pair_modify compute "
-                                  "yes'"));
+    fail(error, FLERR,
+         std::string("Fix fibre_contact computes every contact force itself, but the "
+                     "pair style's force computation is on: define the pair style "
+                     "before fix fibre_contact and do not use 'pair_modify compute "
+                     "yes'"));
 }
 
 // The friction and restitution coefficients per type pair from the pair style (coefficients
@@ -182,10 +214,10 @@ void FixFibreContact::read_coefficients()
   const fibre_lmp::PairReading reading = fibre_lmp::read_pair_coefficients(lmp);
   if (!reading.failure.empty()) {
     if (comm->me == 0)
-      error->warning(FLERR, "Fix fibre_contact: cannot read the pair style's coefficients (" +
-                                reading.failure +
-                                "); every contact takes the fix's mu, mu_roll, mu_twist and "
-                                "restitution");
+      warn(error, FLERR,
+           "Fix fibre_contact: cannot read the pair style's coefficients (" + reading.failure +
+               "); every contact takes the fix's mu, mu_roll, mu_twist and "
+               "restitution");
     return;
   }
   model.materials = reading.table;
@@ -195,10 +227,11 @@ void FixFibreContact::read_coefficients()
     for (int j = i; j <= reading.table.ntypes(); ++j)
       frictionless = frictionless && reading.table.at(i, j).mu == 0.0;
   if (frictionless)
-    error->warning(FLERR, std::string("Fix fibre_contact: the pair style's friction coefficient "
-                                      "is 0 for every type pair, so every contact is "
-                                      "frictionless (give the fix's mu keyword, or "
-                                      "'coefficients fix', to set it)"));
+    warn(error, FLERR,
+         std::string("Fix fibre_contact: the pair style's friction coefficient "
+                     "is 0 for every type pair, so every contact is "
+                     "frictionless (give the fix's mu keyword, or "
+                     "'coefficients fix', to set it)"));
   std::string text = "fix fibre_contact: coefficients from pair style " +
                      std::string(force->pair_style) + " (types i j; walls take i i";
   const fibre::TypedCoefficients &t = model.typed;
@@ -207,10 +240,9 @@ void FixFibreContact::read_coefficients()
             (t.mu_roll ? " mu_roll" : "") + (t.mu_twist ? " mu_twist" : "") +
             (t.restitution ? " restitution" : "");
   text += "):\n";
-  for (const std::string &line : fibre_lmp::describe_table(reading.table))
-    text += "  " + line + "\n";
+  for (const std::string &line : reading.table.describe()) text += "  " + line + "\n";
   for (const std::string &note : reading.notes) text += "  note: " + note + "\n";
-  utils::logmesg(lmp, text);
+  logmesg(lmp, text);
 }
 
 // Computes that read the pair style's own forces see none: its force computation is off.
@@ -222,11 +254,11 @@ void FixFibreContact::warn_pair_computes()
   for (int i = 0; i < modify->ncompute; ++i) {
     const std::string style = modify->compute[i]->style;
     if (style == "pair/local" || style == "contact/atom" || style == "pair")
-      error->warning(FLERR, "Fix fibre_contact: compute " + std::string(modify->compute[i]->id) +
-                                " (" + style +
-                                ") reads the pair style, whose forces are switched off: it sees "
-                                "no contact forces (fix fibre_contact's local array f_" +
-                                id + " has them)");
+      warn(error, FLERR,
+           "Fix fibre_contact: compute " + std::string(modify->compute[i]->id) + " (" + style +
+               ") reads the pair style, whose forces are switched off: it sees "
+               "no contact forces (fix fibre_contact's local array f_" +
+               id + " has them)");
   }
 }
 
@@ -242,35 +274,35 @@ void FixFibreContact::warn_double_integration()
     int all = 0;
     MPI_Allreduce(&mine, &all, 1, MPI_INT, MPI_SUM, world);
     if (all > 0 && comm->me == 0)
-      error->warning(FLERR, std::string("Fix fibre_contact: fix ") + other->id + " (" +
-                                other->style + ") also time-integrates " + std::to_string(all) +
-                                " atoms of group " + group->names[igroup] +
-                                ": they are moved twice per step");
+      warn(error, FLERR,
+           std::string("Fix fibre_contact: fix ") + other->id + " (" + other->style +
+               ") also time-integrates " + std::to_string(all) + " atoms of group " +
+               group->names[igroup] + ": they are moved twice per step");
   }
 }
 
 void FixFibreContact::init()
 {
-  if (utils::strmatch(update->integrate_style, "^respa"))
-    error->all(FLERR, std::string("Fix fibre_contact does not support run_style respa"));
+  if (starts_with(update->integrate_style, "respa"))
+    fail(error, FLERR, std::string("Fix fibre_contact does not support run_style respa"));
   check_pair_style(true);
   dtv_ = update->dt;
   detection_->init_walls(settings_.walls);
   warn_double_integration();
   warn_pair_computes();
   read_coefficients();
-  if (comm->me == 0) utils::logmesg(lmp, "fix fibre_contact: " + fibre::describe(settings_) + "\n");
+  if (comm->me == 0) logmesg(lmp, "fix fibre_contact: " + fibre::describe(settings_) + "\n");
 }
 
 /* ---------------------------------------------------------------------- */
 
 void FixFibreContact::setup(int vflag)
 {
-  v_init(vflag); // no contact forces before the run's first step: a zero virial
+  start_virial(vflag); // no contact forces before the run's first step: a zero virial
   first_step_ = true;
   detection_->start_moving_walls();
   if (!force->pair || !force->pair->list)
-    error->all(FLERR, std::string("Fix fibre_contact found no neighbor list of the pair style"));
+    fail(error, FLERR, std::string("Fix fibre_contact found no neighbor list of the pair style"));
   dtv_ = update->dt;
 }
 
@@ -301,9 +333,10 @@ void FixFibreContact::check_finite(const char *what, double **array, int nvalues
     if (!(mask[i] & groupbit)) continue;
     for (int d = 0; d < nvalues; ++d)
       if (!std::isfinite(array[i][d]))
-        error->one(FLERR, std::string("Fix fibre_contact: non-finite ") + what + " of atom " +
-                              std::to_string(static_cast<long long>(atom->tag[i])) + " at step " +
-                              std::to_string(static_cast<long long>(update->ntimestep)));
+        fail_one(error, FLERR,
+                 std::string("Fix fibre_contact: non-finite ") + what + " of atom " +
+                     std::to_string(static_cast<long long>(atom->tag[i])) + " at step " +
+                     std::to_string(static_cast<long long>(update->ntimestep)));
   }
 }
 
@@ -349,11 +382,12 @@ void FixFibreContact::warn_deep_overlaps(const std::vector<fibre::Body> &bodies,
   }
   MPI_Allreduce(MPI_IN_PLACE, &deepest, 1, MPI_DOUBLE, MPI_MAX, world);
   if (deepest > kDeepOverlap && comm->me == 0)
-    error->warning(FLERR, "Fix fibre_contact: the run starts with overlaps of up to " +
-                              fibre::format_g(100.0 * deepest) +
-                              "% of a diameter; they are removed at recovery_speed " +
-                              (max_recovery > 0 ? fibre::format_g(max_recovery) : "none") +
-                              " (SPOOK removes any overlap within a few steps otherwise)");
+    warn(error, FLERR,
+         "Fix fibre_contact: the run starts with overlaps of up to " +
+             fibre::format_g(100.0 * deepest) +
+             "% of a diameter; they are removed at recovery_speed " +
+             (max_recovery > 0 ? fibre::format_g(max_recovery) : "none") +
+             " (SPOOK removes any overlap within a few steps otherwise)");
 }
 
 /* ----------------------------------------------------------------------
@@ -367,9 +401,9 @@ fibre::StepResult FixFibreContact::solve(fibre::ContactSystem &sys, const fibre:
   try {
     res = fibre::solve_step(sys, *exchange_, settings_.step, &warm, world);
   } catch (std::exception &e) {
-    error->one(FLERR, std::string("Fix fibre_contact: contact solver failed at step ") +
-                          std::to_string(static_cast<long long>(update->ntimestep)) + ": " +
-                          e.what());
+    fail_one(error, FLERR,
+             std::string("Fix fibre_contact: contact solver failed at step ") +
+                 std::to_string(static_cast<long long>(update->ntimestep)) + ": " + e.what());
   }
   const Eigen::Index owned = 6 * Eigen::Index(exchange_->num_owned());
   const bool finite =
@@ -382,9 +416,10 @@ fibre::StepResult FixFibreContact::solve(fibre::ContactSystem &sys, const fibre:
     res.lambda = fibre::Vector::Zero(sys.contact_dofs());
     res.dv.resize(0);
     if (comm->me == 0)
-      error->warning(FLERR, "Fix fibre_contact: the contact solve at step " +
-                                std::to_string(static_cast<long long>(update->ntimestep)) +
-                                " gave non-finite impulses; the step ignores the contacts");
+      warn(error, FLERR,
+           "Fix fibre_contact: the contact solve at step " +
+               std::to_string(static_cast<long long>(update->ntimestep)) +
+               " gave non-finite impulses; the step ignores the contacts");
   }
   return res;
 }
@@ -471,9 +506,9 @@ void FixFibreContact::final_integrate()
   if (do_export)
     output_->export_step(settings_.export_prefix, sys, found, any ? &res.lambda : nullptr, warm);
   if (overflow_count_ > 0 && !overflow_warned_ && comm->me == 0) {
-    error->warning(FLERR, "Fix fibre_contact: more than " +
-                              std::to_string(fibre::ContactHistory::kMaxSlots) +
-                              " contacts stored on one atom; the rest start cold next step");
+    warn(error, FLERR,
+         "Fix fibre_contact: more than " + std::to_string(fibre::ContactHistory::kMaxSlots) +
+             " contacts stored on one atom; the rest start cold next step");
     overflow_warned_ = true;
   }
   check_finite("velocity", atom->v, 3);
@@ -562,13 +597,13 @@ int FixFibreContact::maxsize_restart()
    halo communication for the Exchange (6 values per atom)
 ------------------------------------------------------------------------- */
 
-int FixFibreContact::pack_forward_comm(int n, int *list, double *buf, int /*pbc_flag*/,
-                                       int * /*pbc*/)
+int FixFibreContact::FIBRE_PACK_FORWARD(int n, int *list, double *buf, int /*pbc_flag*/,
+                                        int * /*pbc*/)
 {
   return exchange_->pack_forward(n, list, buf);
 }
 
-void FixFibreContact::unpack_forward_comm(int n, int first, double *buf)
+void FixFibreContact::FIBRE_UNPACK_FORWARD(int n, int first, double *buf)
 {
   exchange_->unpack_forward(first, n, buf);
 }

@@ -47,14 +47,16 @@ class FixFibreContact : public Fix {
   int size_restart(int) override;
   int maxsize_restart() override;
 
-  int pack_forward_comm(int, int *, double *, int, int *) override;
-  void unpack_forward_comm(int, int, double *) override;
+  // pack_forward_comm/unpack_forward_comm (LAMMPS), pack_comm/unpack_comm (LIGGGHTS)
+  int FIBRE_PACK_FORWARD(int, int *, double *, int, int *) override;
+  void FIBRE_UNPACK_FORWARD(int, int, double *) override;
   int pack_reverse_comm(int, int, double *) override;
   void unpack_reverse_comm(int, int *, double *) override;
 
   double memory_usage() override;
 
  protected:
+  void start_virial(int vflag);
   void check_pair_style(bool at_init);
   void warn_double_integration();
   void warn_pair_computes();

@@ -24,4 +24,6 @@ inline auto make_args_checked(const S &, const Args &...args)
 #define FIBRE_LAMMPS_COMM_FIX_API 1 // 2021 API: forward_comm_fix / reverse_comm_fix
 #define fibre_forward_comm(comm, fix, n) (comm)->forward_comm_fix((fix), (n))
 #define fibre_reverse_comm(comm, fix, n) (comm)->reverse_comm_fix((fix), (n))
+#define FIBRE_PACK_FORWARD pack_forward_comm
+#define FIBRE_UNPACK_FORWARD unpack_forward_comm
 #endif

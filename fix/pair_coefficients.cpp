@@ -9,7 +9,6 @@
 #include "force.h"
 #include "lammps.h"
 #include "pair.h"
-#include "utils.h"
 
 namespace fibre_lmp {
 
@@ -194,24 +193,6 @@ PairReading read_pair_coefficients(LAMMPS_NS::LAMMPS *lmp)
     out.failure = "pair style " + style + " has no coefficients the fix can read";
   }
   return out;
-}
-
-std::vector<std::string> describe_table(const fibre::MaterialTable &table)
-{
-  std::vector<std::string> lines;
-  const auto g = fibre::format_g;
-  for (int i = 1; i <= table.ntypes(); ++i)
-    for (int j = i; j <= table.ntypes(); ++j) {
-      const fibre::PairCoefficients &p = table.at(i, j);
-      std::string line = std::to_string(i) + " " + std::to_string(j) + ": mu " + g(p.mu) +
-                         ", mu_roll " + g(p.mu_roll) + ", twisting ";
-      line += p.twist == fibre::TwistLaw::sds        ? "sds " + g(p.twist_coeff)
-              : p.twist == fibre::TwistLaw::marshall ? std::string("marshall")
-                                                     : std::string("none");
-      line += ", restitution " + (p.restitution >= 0 ? g(p.restitution) : std::string("none"));
-      lines.push_back(line);
-    }
-  return lines;
 }
 
 } // namespace fibre_lmp

@@ -1,5 +1,7 @@
 /* ----------------------------------------------------------------------
-   The granular pair style's coefficients per type pair, for fix fibre_contact.
+   The granular pair style's coefficients per type pair, for fix fibre_contact. Each front end
+   has its own reader: fix/pair_coefficients.cpp (LAMMPS) and liggghts/property_materials.cpp
+   (LIGGGHTS fix property/global).
 
    LAMMPS exposes them through no API here (doc/design.md section 5): the pair style's
    write_restart() record, written into memory, is read instead. Known layouts: pair_style
@@ -25,10 +27,6 @@ struct PairReading {
 };
 
 PairReading read_pair_coefficients(LAMMPS_NS::LAMMPS *lmp);
-
-// One line per type pair i <= j for the log: "1 1: mu 0.4, mu_roll 0.1, twisting sds 0.07,
-// restitution 0.3".
-std::vector<std::string> describe_table(const fibre::MaterialTable &table);
 
 } // namespace fibre_lmp
 

@@ -15,7 +15,8 @@ import sys
 
 LAYERS = {
     0: ["system", "exchange", "names", "text"],
-    1: ["material", "contact_model", "kernels", "contact_rows", "detection", "contact_history"],
+    1: ["material", "contact_model", "kernels", "contact_rows", "detection", "mesh",
+        "contact_history"],
     2: ["spook", "operators", "fibres", "cones", "assembly", "system_io", "stress"],
     3: ["solver_control", "preconditioner", "preconditioner_family", "krylov", "direct", "pgs",
         "spectra", "analysis", "combined_preconditioner", "nonsmooth_reference"],

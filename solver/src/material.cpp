@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include "fibre/text.hpp"
+
 namespace fibre {
 
 MaterialTable::MaterialTable(int ntypes)
@@ -129,5 +131,24 @@ bool material_compliance(const PairCoefficients &p, double r_eff, double overlap
     }
   return true;
 }
+
+std::vector<std::string> MaterialTable::describe() const
+{
+  std::vector<std::string> lines;
+  const auto g = format_g;
+  for (int i = 1; i <= ntypes(); ++i)
+    for (int j = i; j <= ntypes(); ++j) {
+      const PairCoefficients &p = at(i, j);
+      std::string line = std::to_string(i) + " " + std::to_string(j) + ": mu " + g(p.mu) +
+                         ", mu_roll " + g(p.mu_roll) + ", twisting ";
+      line += p.twist == TwistLaw::sds        ? "sds " + g(p.twist_coeff)
+              : p.twist == TwistLaw::marshall ? std::string("marshall")
+                                                     : std::string("none");
+      line += ", restitution " + (p.restitution >= 0 ? g(p.restitution) : std::string("none"));
+      lines.push_back(line);
+    }
+  return lines;
+}
+
 
 } // namespace fibre

@@ -81,18 +81,21 @@ std::size_t read_plane_motion(const Reader &in, std::size_t i, WallSpec &w)
   return 3;
 }
 
-// "wall xplane|yplane|zplane <lo|NULL> <hi|NULL>" or "wall region <region-ID>" at args[i];
-// returns the number of words read.
+// "wall xplane|yplane|zplane <lo|NULL> <hi|NULL>", "wall region <region-ID>" or
+// "wall mesh <fix-ID>" at args[i]; returns the number of words read.
 std::size_t read_wall(const Reader &in, std::size_t i, WallSpec &w)
 {
   const std::string e =
-      "'wall xplane|yplane|zplane <lo|NULL> <hi|NULL>' or 'wall region <region-ID>'";
+      "'wall xplane|yplane|zplane <lo|NULL> <hi|NULL>', 'wall region <region-ID>' or 'wall mesh "
+      "<fix-ID>'";
   if (!in.has(i + 1)) Reader::illegal(e);
   const std::string &kind = in.at(i + 1);
   if (!parse(kind, w.kind)) Reader::illegal(e, &kind);
-  if (w.kind == WallKind::region) {
-    if (!in.has(i + 2)) Reader::illegal("'wall region <region-ID>'");
-    w.region_id = in.at(i + 2);
+  if (!w.is_plane()) {
+    const std::string ek = w.kind == WallKind::region ? "'wall region <region-ID>'"
+                                                      : "'wall mesh <fix-ID>' (a fix mesh/surface)";
+    if (!in.has(i + 2)) Reader::illegal(ek);
+    w.id = in.at(i + 2);
     return 3;
   }
   const std::string ep = "'wall " + kind + " <lo|NULL> <hi|NULL>'";

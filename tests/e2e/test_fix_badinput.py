@@ -74,8 +74,10 @@ CASES = [
     ("rows_invalid", "rows 4", "expected 'rows 3|6', got '4'", {}),
     ("active_set_zero", "active_set 0", "expected 'active_set <positive integer>', got '0'",
      {}),
-    ("wall_kind", "wall cylinder 1 2", "'wall xplane|yplane|zplane <lo|NULL> <hi|NULL>' or "
-     "'wall region <region-ID>', got 'cylinder'", {}),
+    ("wall_kind", "wall cylinder 1 2", "'wall xplane|yplane|zplane <lo|NULL> <hi|NULL>', "
+     "'wall region <region-ID>' or 'wall mesh <fix-ID>', got 'cylinder'", {}),
+    ("wall_mesh_lammps", "wall mesh cad", "mesh walls (fix mesh/surface) need the LIGGGHTS front "
+     "end", {}),
     ("wall_plane_missing", "wall zplane 0.0", "expected 'wall zplane <lo|NULL> <hi|NULL>'",
      {}),
     ("wall_plane_null", "wall zplane NULL NULL", "expected 'wall zplane <lo|NULL> <hi|NULL>' "

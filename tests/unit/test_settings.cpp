@@ -95,7 +95,13 @@ TEST(Settings, EveryKeywordSetsWhatItNames)
   EXPECT_EQ(s.walls[1].axis(), 0);
   EXPECT_DOUBLE_EQ(s.walls[1].lo, -1.0);
   EXPECT_DOUBLE_EQ(s.walls[1].hi, 1.0);
-  EXPECT_EQ(s.walls[2].region_id, "box");
+  EXPECT_EQ(s.walls[2].id, "box");
+  const Settings mesh = parse_settings(words("wall mesh hopper wall zplane 0 NULL"));
+  ASSERT_EQ(mesh.walls.size(), 2u);
+  EXPECT_EQ(mesh.walls[0].kind, WallKind::mesh);
+  EXPECT_EQ(mesh.walls[0].id, "hopper");
+  EXPECT_FALSE(mesh.walls[0].is_plane());
+  EXPECT_TRUE(mesh.walls[1].is_plane());
   EXPECT_EQ(s.export_every, 10);
   EXPECT_EQ(s.export_prefix, "out/sys");
   EXPECT_NE(describe(s).find("compliance 1e-07 2e-07"), std::string::npos);
@@ -156,6 +162,10 @@ TEST(Settings, BadInputNamesTheKeywordAndItsForm)
   EXPECT_EQ(error_of("wall zplane 2 1"),
             "expected 'wall zplane <lo|NULL> <hi|NULL>' with lo < hi, got '2 1'");
   EXPECT_EQ(error_of("wall region"), "expected 'wall region <region-ID>'");
+  EXPECT_EQ(error_of("wall mesh"), "expected 'wall mesh <fix-ID>' (a fix mesh/surface)");
+  EXPECT_EQ(error_of("wall cylinder 3"),
+            "expected 'wall xplane|yplane|zplane <lo|NULL> <hi|NULL>', 'wall region <region-ID>' "
+            "or 'wall mesh <fix-ID>', got 'cylinder'");
   EXPECT_EQ(error_of("export 10"), "expected 'export <N> <file-prefix>' (N a positive integer)");
   EXPECT_EQ(error_of("rows 3 mu_roll 0.1"),
             "mu_roll and mu_twist need 'rows 6' (rows 3 has no rotational rows)");

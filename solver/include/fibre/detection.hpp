@@ -20,15 +20,24 @@ inline double wall_key(int wall, int sub)
 {
   return -static_cast<double>(wall * kWallKeyStride + sub + 1);
 }
+// Mesh contacts are keyed by wall and triangle ID, below every wall_key (exact in a double up to
+// 2^53: 2^40 triangle IDs over 1024 walls).
+inline constexpr double kMeshKeyBase = 1099511627776.0; // 2^40
+inline double mesh_key(int wall, long triangle)
+{
+  return -(kMeshKeyBase + static_cast<double>(triangle) * kWallKeyStride + wall + 1);
+}
 
-// A wall: one or two planes normal to an axis (lo below, hi above the grains), or a region of
-// the front end, named by its ID.
-enum class WallKind { xplane, yplane, zplane, region };
+// A wall: one or two planes normal to an axis (lo below, hi above the grains), a region of the
+// front end (LAMMPS), or a triangle mesh of the front end (LIGGGHTS fix mesh/surface), named by
+// its ID.
+enum class WallKind { xplane, yplane, zplane, region, mesh };
 template <> struct EnumNames<WallKind> {
   static constexpr EnumName<WallKind> table[] = {{WallKind::xplane, "xplane"},
                                                  {WallKind::yplane, "yplane"},
                                                  {WallKind::zplane, "zplane"},
-                                                 {WallKind::region, "region"}};
+                                                 {WallKind::region, "region"},
+                                                 {WallKind::mesh, "mesh"}};
 };
 
 // How a plane wall moves (fix wall/gran's keywords): wiggle = oscillation along motion_axis,
@@ -40,11 +49,12 @@ struct WallSpec {
   WallKind kind = WallKind::zplane;
   bool has_lo = false, has_hi = false;
   double lo = 0.0, hi = 0.0;
-  std::string region_id;
+  std::string id; // region or mesh: the front end's region ID or mesh fix ID
   WallMotion motion = WallMotion::none;
   int motion_axis = 0;
   double amplitude = 0.0, period = 1.0, shear_speed = 0.0;
   int axis() const { return static_cast<int>(kind); } // planes: 0 x, 1 y, 2 z
+  bool is_plane() const { return kind != WallKind::region && kind != WallKind::mesh; }
   // The planes' displacement along their own axis and their velocity at time t since the
   // wall was defined.
   double offset(double t) const;

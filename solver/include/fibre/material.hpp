@@ -58,6 +58,9 @@ class MaterialTable {
   // coefficient, which is what LAMMPS mixes). Returns "" or what cannot be mixed (a type
   // without coefficients, or two twisting laws).
   std::string mix();
+  // One line per type pair i <= j for the log: "1 1: mu 0.4, mu_roll 0.1, twisting sds 0.07,
+  // restitution 0.3".
+  std::vector<std::string> describe() const;
 
  private:
   int ntypes_ = 0;

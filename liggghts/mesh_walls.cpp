@@ -1,0 +1,120 @@
+// The LIGGGHTS host's own walls: triangle meshes of fix mesh/surface (static, or moved by fix
+// move/mesh, or with a conveyor's surface velocity). Each step the process's local and ghost
+// triangles, with their node velocities, go into a grid of the library's (fibre/mesh.hpp); each
+// owned sphere keeps one contact per face, edge or vertex it touches, keyed by the triangle's
+// global ID (warm starts follow the triangle). A LAMMPS region needs the LAMMPS front end.
+#include <algorithm>
+#include <memory>
+#include <string>
+
+#include "error.h"
+#include "fibre/mesh.hpp"
+#include "fibre_detect.h"
+#include "fix_mesh_surface.h"
+#include "host.h"
+#include "lammps_exchange.h"
+#include "modify.h"
+#include "neighbor.h"
+#include "tri_mesh.h"
+
+using namespace LAMMPS_NS;
+
+namespace fibre_lmp {
+
+struct LammpsDetection::HostWalls {
+  std::vector<FixMeshSurface *> meshes; // per wall, or nullptr
+  mutable std::vector<fibre::Triangle> triangles;
+  mutable fibre::TriangleGrid grid;
+  mutable std::vector<fibre::TriangleHit> hits;
+};
+
+// Constructed and destroyed where HostWalls is complete.
+LammpsDetection::LammpsDetection(LAMMPS *lmp, int groupbit, LammpsExchange &exchange)
+    : Pointers(lmp), groupbit_(groupbit), exchange_(exchange)
+{
+}
+
+LammpsDetection::~LammpsDetection() = default;
+
+void LammpsDetection::init_host_wall(int w)
+{
+  if (!host_walls_) host_walls_ = std::make_unique<HostWalls>();
+  host_walls_->meshes.resize(walls_.size(), nullptr);
+  const std::string &id = walls_[w].id;
+  if (walls_[w].kind == fibre::WallKind::region)
+    fail(error, FLERR,
+         "Fix fibre_contact 'wall region " + id +
+             "': LIGGGHTS regions are not walls for this fix; give the wall as a mesh ('fix ID "
+             "all mesh/surface file F.stl type T' and 'wall mesh ID') or a plane ('wall zplane "
+             "lo hi')");
+  Fix *fix = modify->find_fix_id(id.c_str());
+  if (!fix)
+    fail(error, FLERR,
+         "Fix fibre_contact 'wall mesh " + id + "': no fix with ID " + id + " (expected 'fix " +
+             id + " all mesh/surface file F.stl type T')");
+  if (!starts_with(fix->style, "mesh/surface"))
+    fail(error, FLERR,
+         "Fix fibre_contact 'wall mesh " + id + "': fix " + id + " is a " + fix->style +
+             ", expected a fix mesh/surface");
+  host_walls_->meshes[w] = static_cast<FixMeshSurface *>(fix);
+}
+
+// fix move/mesh moves the nodes itself and sets their velocities; nothing to record here.
+void LammpsDetection::start_moving_walls() {}
+
+namespace {
+
+// The local and ghost triangles of a mesh, with node velocities where the mesh moves.
+void read_triangles(TriMesh *mesh, std::vector<fibre::Triangle> &out)
+{
+  const int n = mesh->sizeLocal() + mesh->sizeGhost();
+  auto *velocity = mesh->prop().getElementProperty<MultiVectorContainer<double, 3, 3>>("v");
+  out.resize(n);
+  for (int t = 0; t < n; ++t) {
+    fibre::Triangle &tri = out[t];
+    tri.id = mesh->id(t);
+    for (int j = 0; j < 3; ++j) {
+      double p[3];
+      mesh->node(t, j, p);
+      tri.p[j] = fibre::Vec3(p[0], p[1], p[2]);
+      tri.v[j] = velocity
+                     ? fibre::Vec3((*velocity)(t)[j][0], (*velocity)(t)[j][1], (*velocity)(t)[j][2])
+                     : fibre::Vec3::Zero();
+    }
+  }
+}
+
+} // namespace
+
+void LammpsDetection::host_wall_contacts(int w, const std::vector<fibre::Body> &bodies, double h,
+                                         double damping,
+                                         std::vector<fibre::DetectedContact> &found) const
+{
+  HostWalls &host = *host_walls_;
+  FixMeshSurface *fix = host.meshes[w];
+  read_triangles(fix->triMesh(), host.triangles);
+  if (host.triangles.empty()) return;
+  double speed = 0.0; // the fastest node bounds the surface speed near any sphere
+  for (const fibre::Triangle &tri : host.triangles)
+    for (const fibre::Vec3 &v : tri.v) speed = std::max(speed, v.norm());
+  host.grid.build(host.triangles, 0.0);
+  const int mesh_type = fix->min_type();
+  const int nowned = exchange_.num_owned();
+  for (int k = 0; k < nowned; ++k) {
+    const fibre::Body &b = bodies[k];
+    const double reach = fibre::region_cutoff(b, h, damping, neighbor->skin, speed);
+    host.hits.clear();
+    fibre::mesh_hits(host.triangles, host.grid, b.x, reach, host.hits);
+    for (const fibre::TriangleHit &hit : host.hits) {
+      const std::size_t before = found.size();
+      add_wall_contact(bodies, k, hit.normal, hit.distance, w, 0, hit.velocity, fibre::Vec3::Zero(),
+                       h, damping, found);
+      if (found.size() == before) continue;
+      fibre::DetectedContact &fc = found.back();
+      fc.partner = fc.key = fibre::mesh_key(w, host.triangles[hit.triangle].id);
+      fc.contact.wall_type = mesh_type;
+    }
+  }
+}
+
+} // namespace fibre_lmp

@@ -1,0 +1,126 @@
+// The material of a LIGGGHTS deck per type pair, for fix fibre_contact (the LIGGGHTS side of
+// fix/pair_coefficients.h): fix property/global tables and the models chosen in
+// `pair_style gran model M tangential T rolling_friction R`.
+//
+//   coefficientFriction peratomtypepair        -> mu
+//   coefficientRestitution peratomtypepair     -> restitution (Newton's e)
+//   coefficientRollingFriction peratomtypepair -> mu_roll, with rolling_friction cdt or epsd*
+//   youngsModulus, poissonsRatio peratomtype   -> model hertz: k_n = 4/3 Y*, k_t = 8 G*
+//     (1/Y* = (1 - nu_i^2)/Y_i + (1 - nu_j^2)/Y_j, 1/G* = 2 (2 - nu_i)(1 + nu_i)/Y_i + ...),
+//     the laws LIGGGHTS's hertz and tangential history apply; `compliance material` uses them.
+// Mesh walls have a type of their own (fix mesh/surface ... type T), so a wall contact takes
+// the pair (sphere type, T) as native LIGGGHTS does.
+#include <cmath>
+#include <string>
+
+#include "atom.h"
+#include "fix_property_global.h"
+#include "force.h"
+#include "lammps.h"
+#include "modify.h"
+#include "pair_coefficients.h"
+#include "pair_gran.h"
+
+namespace fibre_lmp {
+
+namespace {
+
+// The fix property/global that registers `name`, or nullptr; `shape` peratomtype or
+// peratomtypepair over every atom type (mesh types included). A table of another shape is an
+// error that names it.
+LAMMPS_NS::FixPropertyGlobal *property(LAMMPS_NS::LAMMPS *lmp, const char *name, const char *shape,
+                                       std::string &failure)
+{
+  const int ntypes = lmp->atom->ntypes;
+  const bool pairs = std::string(shape) == "peratomtypepair";
+  for (int i = 0; i < lmp->modify->nfix; ++i) {
+    LAMMPS_NS::Fix *fix = lmp->modify->fix[i];
+    if (std::string(fix->style) != "property/global") continue;
+    auto *table = static_cast<LAMMPS_NS::FixPropertyGlobal *>(fix);
+    if (!table->check_fix(name, "", 0, 0, "fix fibre_contact", false)) continue;
+    if (table->check_fix(name, shape, ntypes, pairs ? ntypes : 0, "fix fibre_contact", false))
+      return table;
+    failure = std::string("fix property/global ") + name + " must be '" + shape + "' with " +
+              (pairs ? std::to_string(ntypes) + " x " : std::string()) + std::to_string(ntypes) +
+              " values";
+    return nullptr;
+  }
+  return nullptr;
+}
+
+bool matches(LAMMPS_NS::PairGran *pair, const char *kind, const char *model)
+{
+  return pair && pair->contact_match(kind, model);
+}
+
+} // namespace
+
+PairReading read_pair_coefficients(LAMMPS_NS::LAMMPS *lmp)
+{
+  PairReading out;
+  const int ntypes = lmp->atom->ntypes;
+  auto *pair = dynamic_cast<LAMMPS_NS::PairGran *>(lmp->force->pair);
+  if (!pair || ntypes < 1) {
+    out.failure = "no pair style gran";
+    return out;
+  }
+  auto *friction = property(lmp, "coefficientFriction", "peratomtypepair", out.failure);
+  auto *restitution = property(lmp, "coefficientRestitution", "peratomtypepair", out.failure);
+  auto *rolling = property(lmp, "coefficientRollingFriction", "peratomtypepair", out.failure);
+  auto *young = property(lmp, "youngsModulus", "peratomtype", out.failure);
+  auto *poisson = property(lmp, "poissonsRatio", "peratomtype", out.failure);
+  if (!out.failure.empty()) return out;
+  if (!friction) {
+    out.failure = "no 'fix ID all property/global coefficientFriction peratomtypepair " +
+                  std::to_string(ntypes) + " ...'";
+    return out;
+  }
+  const bool cdt =
+      matches(pair, "rolling_friction", "cdt") || matches(pair, "rolling_friction", "epsd") ||
+      matches(pair, "rolling_friction", "epsd2") || matches(pair, "rolling_friction", "epsd3");
+  const bool hertz = matches(pair, "normal", "hertz");
+  const bool history = matches(pair, "tangential", "history");
+  if (rolling && !cdt)
+    out.notes.push_back("coefficientRollingFriction is not used: the pair style has no "
+                        "rolling_friction model (as in native LIGGGHTS)");
+  if (cdt && !rolling) {
+    out.failure = "rolling_friction needs 'fix ID all property/global coefficientRollingFriction "
+                  "peratomtypepair " +
+                  std::to_string(ntypes) + " ...'";
+    return out;
+  }
+  if (!hertz)
+    out.notes.push_back("the normal model is not hertz: compliance material has no elastic "
+                        "constants here (LIGGGHTS's hooke stiffness depends on each contact's "
+                        "mass and characteristicVelocity); the rows stay rigid");
+  if (!restitution)
+    out.notes.push_back("no coefficientRestitution: contacts are plastic unless the fix's "
+                        "restitution keyword is given");
+
+  fibre::MaterialTable table(ntypes);
+  for (int i = 1; i <= ntypes; ++i)
+    for (int j = i; j <= ntypes; ++j) {
+      fibre::PairCoefficients &p = table.at(i, j);
+      p.set = true;
+      p.mu = friction->compute_array(i - 1, j - 1);
+      if (cdt) p.mu_roll = rolling->compute_array(i - 1, j - 1);
+      if (restitution) p.restitution = restitution->compute_array(i - 1, j - 1);
+      if (hertz && young && poisson) {
+        const double yi = young->compute_vector(i - 1), yj = young->compute_vector(j - 1);
+        const double ni = poisson->compute_vector(i - 1), nj = poisson->compute_vector(j - 1);
+        const double y_eff = 1.0 / ((1.0 - ni * ni) / yi + (1.0 - nj * nj) / yj);
+        const double g_eff =
+            1.0 / (2.0 * (2.0 - ni) * (1.0 + ni) / yi + 2.0 * (2.0 - nj) * (1.0 + nj) / yj);
+        p.normal = fibre::NormalLaw::hertz_material;
+        p.k_n = 4.0 / 3.0 * y_eff;
+        if (history) {
+          p.tangential = fibre::TangentialLaw::mindlin;
+          p.k_t = 8.0 * g_eff;
+        }
+      }
+    }
+  out.table = std::move(table);
+  return out;
+}
+
+} // namespace fibre_lmp
