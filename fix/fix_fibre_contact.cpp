@@ -212,6 +212,11 @@ void FixFibreContact::read_coefficients()
   model.materials = fibre::MaterialTable();
   if (model.coefficients != fibre::CoefficientSource::pair) return;
   const fibre_lmp::PairReading reading = fibre_lmp::read_pair_coefficients(lmp);
+  if (!reading.failure.empty() && reading.required)
+    fail(error, FLERR,
+         "Fix fibre_contact reads the material from the deck: " + reading.failure +
+             " (or give 'coefficients fix' to take the fix's mu, mu_roll, mu_twist and "
+             "restitution)");
   if (!reading.failure.empty()) {
     if (comm->me == 0)
       warn(error, FLERR,
@@ -600,7 +605,8 @@ int FixFibreContact::maxsize_restart()
 int FixFibreContact::FIBRE_PACK_FORWARD(int n, int *list, double *buf, int /*pbc_flag*/,
                                         int * /*pbc*/)
 {
-  return exchange_->pack_forward(n, list, buf);
+  return fibre_lmp::packed_count(exchange_->pack_forward(n, list, buf),
+                                 fibre_lmp::LammpsExchange::kValuesPerAtom);
 }
 
 void FixFibreContact::FIBRE_UNPACK_FORWARD(int n, int first, double *buf)
@@ -610,7 +616,8 @@ void FixFibreContact::FIBRE_UNPACK_FORWARD(int n, int first, double *buf)
 
 int FixFibreContact::pack_reverse_comm(int n, int first, double *buf)
 {
-  return exchange_->pack_reverse(first, n, buf);
+  return fibre_lmp::packed_count(exchange_->pack_reverse(first, n, buf),
+                                 fibre_lmp::LammpsExchange::kValuesPerAtom);
 }
 
 void FixFibreContact::unpack_reverse_comm(int n, int *list, double *buf)

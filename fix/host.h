@@ -8,6 +8,7 @@
 // - Halo communication: comm->forward_comm_fix(fix, n) in LAMMPS, (fix) in LIGGGHTS (the
 //   fix's comm_forward decides); the macros fibre_forward_comm/fibre_reverse_comm come from the
 //   force-included compat header of each host (lammps_compat.h, liggghts/liggghts_compat.h).
+//   pack_*_comm return the number of values in LAMMPS, the values per atom in LIGGGHTS.
 // - Atom callbacks: Atom::GROW/RESTART in LAMMPS, the numbers 0/1 in LIGGGHTS.
 #pragma once
 
@@ -39,6 +40,19 @@ inline const std::string &host_text(const std::string &message)
   return message;
 }
 #endif
+
+// What a fix's pack_*_comm returns: the values packed in LAMMPS, the values per atom in
+// LIGGGHTS (its Comm multiplies by the number of atoms).
+inline int packed_count(int total, int per_atom)
+{
+#ifdef FIBRE_HOST_LIGGGHTS
+  (void)total;
+  return per_atom;
+#else
+  (void)per_atom;
+  return total;
+#endif
+}
 
 // Error->all: every process stops with the message.
 [[noreturn]] inline void fail(LAMMPS_NS::Error *error, const char *file, int line,

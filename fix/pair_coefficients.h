@@ -24,6 +24,7 @@ struct PairReading {
   fibre::MaterialTable table;     // empty when the style gave nothing usable
   std::vector<std::string> notes; // what the fix does not use, one line each
   std::string failure;            // why nothing could be read ("" if it could)
+  bool required = false; // the host defines its material here (LIGGGHTS): a failure is an error
 };
 
 PairReading read_pair_coefficients(LAMMPS_NS::LAMMPS *lmp);

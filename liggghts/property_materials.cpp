@@ -58,6 +58,7 @@ bool matches(LAMMPS_NS::PairGran *pair, const char *kind, const char *model)
 PairReading read_pair_coefficients(LAMMPS_NS::LAMMPS *lmp)
 {
   PairReading out;
+  out.required = true;
   const int ntypes = lmp->atom->ntypes;
   auto *pair = dynamic_cast<LAMMPS_NS::PairGran *>(lmp->force->pair);
   if (!pair || ntypes < 1) {

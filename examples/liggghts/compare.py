@@ -151,8 +151,8 @@ def hopper(path, lo, hi):
     empty = t[n <= 0]
     wall, sim, wps, wps_last = timing(blocks)
     wps_win = float("nan")
-    if dis.has("cpu") and sel.sum() >= 2:       # thermo cpu: wall seconds since the run began
-        c, tw = dis.col("cpu")[sel], t[sel]
+    if (dis.has("cpu") or dis.has("CPU")) and sel.sum() >= 2:       # thermo cpu: wall seconds since the run began
+        c, tw = dis.col("cpu", "CPU")[sel], t[sel]
         wps_win = (c[-1] - c[0]) / (tw[-1] - tw[0])
     inserted = int(max(joined(blocks, "Atoms")))
     return {
