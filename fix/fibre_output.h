@@ -8,6 +8,7 @@
 #include "fibre/detection.hpp"
 #include "fibre/spook.hpp"
 #include "fibre/step_solver.hpp"
+#include "fibre/stress.hpp"
 #include "pointers.h"
 
 namespace fibre_lmp {
@@ -45,6 +46,14 @@ class FibreOutput : protected LAMMPS_NS::Pointers {
   ~FibreOutput() override;
 
   double stat(int n) const { return n >= 0 && n < V_SIZE ? stats_[n] : 0.0; }
+  // The last step's load on wall w: force x, y, z and torque about the origin x, y, z.
+  void set_wall_loads(const std::vector<fibre::WallLoad> &loads) { wall_loads_ = loads; }
+  double wall_load(int w, int column) const
+  {
+    return w >= 0 && w < static_cast<int>(wall_loads_.size()) && column >= 0 && column < 6
+               ? wall_loads_[w][column]
+               : 0.0;
+  }
 
   // Contacts, wall contacts and the deepest overlap over all processes; returns the number
   // of contacts.
@@ -69,6 +78,7 @@ class FibreOutput : protected LAMMPS_NS::Pointers {
 
  private:
   double stats_[V_SIZE] = {};
+  std::vector<fibre::WallLoad> wall_loads_;
   LAMMPS_NS::bigint nonconverged_total_ = 0;
   LAMMPS_NS::bigint nonconverged_since_warning_ = 0;
   LAMMPS_NS::bigint last_warning_step_ = -1;

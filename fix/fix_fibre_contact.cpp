@@ -92,6 +92,13 @@ FixFibreContact::FixFibreContact(LAMMPS *lmp, int narg, char **arg) : Fix(lmp, n
   } catch (fibre::SettingsError &e) {
     fail(error, FLERR, std::string("Illegal fix fibre_contact command: ") + e.what());
   }
+  // the load on each wall: f_ID[w][1..6], force and torque about the origin
+  if (!settings_.walls.empty()) {
+    array_flag = 1;
+    size_array_rows = static_cast<int>(settings_.walls.size());
+    size_array_cols = 6;
+    extarray = 1;
+  }
 
   time_origin_ = simulated_time(); // moving planes start their motion here, as fix wall/gran's
   exchange_ = std::make_unique<fibre_lmp::LammpsExchange>(lmp, this, world);
@@ -160,6 +167,24 @@ void FixFibreContact::start_virial(int vflag)
 #else
   v_init(vflag);
 #endif
+}
+
+/* ----------------------------------------------------------------------
+   the walls' loads over all processes (collective)
+------------------------------------------------------------------------- */
+
+void FixFibreContact::tally_wall_loads(const fibre::ContactSystem &sys,
+                                       const std::vector<fibre::DetectedContact> &found,
+                                       const fibre::Vector &lambda)
+{
+  const int nwalls = static_cast<int>(settings_.walls.size());
+  if (nwalls == 0) return;
+  std::vector<int> wall_of(found.size());
+  for (std::size_t c = 0; c < found.size(); ++c) wall_of[c] = found[c].wall;
+  std::vector<fibre::WallLoad> loads;
+  fibre::wall_loads(sys, lambda, wall_of, nwalls, loads);
+  exchange_->sum(loads.empty() ? nullptr : loads[0].data(), 6 * nwalls);
+  output_->set_wall_loads(loads);
 }
 
 /* ----------------------------------------------------------------------
@@ -492,6 +517,7 @@ void FixFibreContact::final_integrate()
   fibre::StepResult res;
   if (any) res = solve(sys, warm);
   update_velocities(res.dv.size() > 0 ? &res.dv : nullptr);
+  tally_wall_loads(sys, found, res.lambda);
   if (evflag) // this step's virial is wanted (post_force)
     tally_virial(sys, res.lambda.size() ? res.lambda : fibre::Vector::Zero(sys.contact_dofs()));
   // the elastic rows' springs (compliance material) and the energy the moving walls put in and
@@ -525,6 +551,11 @@ void FixFibreContact::final_integrate()
 double FixFibreContact::compute_vector(int n)
 {
   return output_->stat(n);
+}
+
+double FixFibreContact::compute_array(int wall, int column)
+{
+  return output_->wall_load(wall, column);
 }
 
 void FixFibreContact::write_restart(FILE *fp)

@@ -33,6 +33,7 @@ class FixFibreContact : public Fix {
   void reset_dt() override;
 
   double compute_vector(int) override;
+  double compute_array(int, int) override;
 
   void write_restart(FILE *) override;
   void restart(char *) override;
@@ -65,6 +66,9 @@ class FixFibreContact : public Fix {
   void smallest_body(const std::vector<fibre::Body> &bodies);
   double bounce_speed(const std::vector<fibre::Body> &bodies) const;
   double simulated_time() const;
+  void tally_wall_loads(const fibre::ContactSystem &sys,
+                        const std::vector<fibre::DetectedContact> &found,
+                        const fibre::Vector &lambda);
   void tally_virial(const fibre::ContactSystem &sys, const fibre::Vector &lambda);
   void warn_deep_overlaps(const std::vector<fibre::Body> &bodies,
                           const std::vector<fibre::DetectedContact> &found, double max_recovery);

@@ -8,6 +8,9 @@ to rest.
 Stage 2: the regions are deleted and redefined between runs with the cylinder open at the
 bottom: the fix picks up the new region (looked up by ID at every run) and the spheres drain
 out of the funnel.
+Wall loads (f_ID[w][1..6]): a column of 4 spheres resting on the floor of a region box, beside
+a plane it does not touch, loads the region with its weight (force down, torque about the
+origin (0, W, 0): the weight acts at x = 1) and the plane it does not touch with nothing.
 Planes: 64 spheres with random velocities in a box of six plane walls
 ('wall xplane/yplane/zplane lo hi', no friction, no gravity) never leave it.
 """
@@ -78,6 +81,33 @@ run 1000
 """
 
 
+COLUMN = """atom_style sphere
+atom_modify map array
+boundary f f f
+newton off
+comm_modify vel yes
+region box block -3 3 -3 3 -1 6 units box
+create_box 1 box
+create_atoms 1 single 1.0 0 0.5 units box
+create_atoms 1 single 1.0 0 1.5 units box
+create_atoms 1 single 1.0 0 2.5 units box
+create_atoms 1 single 1.0 0 3.5 units box
+set group all diameter 1.0 density 1.0
+pair_style gran/hooke 1.0 NULL 0.0 NULL 0.0 0
+pair_coeff * *
+neighbor 0.1 bin
+timestep 0.005
+fix g all gravity 1.0 vector 0 0 -1
+region cup block -2 2 -2 2 0 5 side in units box
+fix fc all fibre_contact mu 0.5 wall region cup wall xplane -2.5 NULL
+thermo_style custom step f_fc[1][1] f_fc[1][2] f_fc[1][3] f_fc[1][4] f_fc[1][5] &
+             f_fc[1][6] f_fc[2][1] f_fc[2][3]
+thermo_modify norm no format float %.15g
+thermo 100
+run 400
+"""
+
+
 def inside_funnel(x, y, z, tol):
     rad = math.hypot(x, y)
     if z <= Z_CONE:
@@ -118,6 +148,19 @@ def main():
         zmin = second[-1]["c_zmin"]
         ck.check(zmin < -1.0, "funnel: redefined region (bottom opened) drains the funnel",
                  "lowest sphere at z = %.3g after the second run" % zmin)
+
+    run = e2e.run_lmp(args, COLUMN, "walls_column")
+    if ck.ran(run, "column: run completes"):
+        weight = 4 * math.pi / 6
+        load = [run.last("f_fc[1][%d]" % k) for k in range(1, 7)]
+        # the weight acts at x = 1: torque about the origin r x F = (1, 0, 0) x (0, 0, -W)
+        expected = [0.0, 0.0, -weight, 0.0, weight, 0.0]
+        worst = max(abs(a - b) for a, b in zip(load, expected))
+        ck.check(worst < 1e-6 * weight, "column: the region's load f_fc[1][1..6] is the weight "
+                 "W = %.6g down, torque (0, W, 0) about the origin" % weight,
+                 "F = (%.3g, %.3g, %.9g), T = (%.3g, %.9g, %.3g)" % tuple(load))
+        ck.check(run.last("f_fc[2][1]") == 0 and run.last("f_fc[2][3]") == 0,
+                 "column: the untouched plane carries nothing")
 
     run = e2e.run_lmp(args, BOX, "walls_box")
     if ck.ran(run, "box of planes: run completes"):

@@ -109,7 +109,7 @@ def rest_on_floor(args, checks):
             "fix floor all mesh/surface file floor.stl type 2",
             "fix fc all fibre_contact wall mesh floor " + opts,
             "variable z equal z[1]",
-            "thermo_style custom step v_z f_fc[3] f_fc[11]",
+            "thermo_style custom step v_z f_fc[3] f_fc[11] f_fc[1][3] f_fc[1][1]",
             "thermo_modify format float %.15g", "thermo 200", "run 2000"]
         run = e2e.run_lmp(args, "\n".join(deck) + "\n", "rest_" + name)
         if not checks.ran(run):
@@ -126,6 +126,9 @@ def rest_on_floor(args, checks):
                          "overlap %.3g r" % (overlap / R))
         checks.check(run.last("fc[11]") == 1, "one wall contact (the two triangles' shared "
                      "edge does not count twice)", "%g" % run.last("fc[11]"))
+        checks.check(abs(run.last("fc[1][3]") + mass() * G) < 1e-3 * mass() * G and
+                     abs(run.last("fc[1][1]")) < 1e-9, "the mesh's load f_fc[1][3] is -m g",
+                     "%.9g vs %.9g" % (run.last("fc[1][3]"), -mass() * G))
 
 
 def incline(args, checks):

@@ -142,6 +142,11 @@ TEST(Detection, WallNames)
   WallKind k;
   EXPECT_TRUE(parse("region", k));
   EXPECT_EQ(k, WallKind::region);
+  EXPECT_TRUE(parse("mesh", k));
+  EXPECT_EQ(k, WallKind::mesh);
   EXPECT_FALSE(parse("cylinder", k));
-  EXPECT_EQ(choices<WallKind>(), "xplane|yplane|zplane|region");
+  EXPECT_EQ(choices<WallKind>(), "xplane|yplane|zplane|region|mesh");
+  EXPECT_LT(mesh_key(0, 0), wall_key(1023, kWallKeyStride - 1));
+  EXPECT_NE(mesh_key(0, 1), mesh_key(1, 0));
+  EXPECT_EQ(mesh_key(2, 123456789), -(kMeshKeyBase + 123456789.0 * kWallKeyStride + 3));
 }

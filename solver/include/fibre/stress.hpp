@@ -3,6 +3,7 @@
 #pragma once
 
 #include <array>
+#include <vector>
 
 #include "fibre/system.hpp"
 
@@ -18,5 +19,14 @@ using Virial = std::array<double, 6>; // xx, yy, zz, xy, xz, yz (LAMMPS's order)
 // processes gives every owned body its share.
 void contact_virial(const ContactSystem &sys, const Vector &lambda, Virial &global,
                     Vector *per_body);
+
+// The load on each wall from this process's contacts: force (x, y, z) and torque about the
+// origin (x, y, z), the reaction to the spheres' contact forces lambda / h at the wall's
+// surface point q = x_a - (r_a + gap) n, rolling and twisting torques included. wall_of[c] is
+// contact c's wall index, or -1 for pairs and obstacles. `loads` is resized to num_walls and
+// overwritten; the front end sums it over processes.
+using WallLoad = std::array<double, 6>;
+void wall_loads(const ContactSystem &sys, const Vector &lambda, const std::vector<int> &wall_of,
+                int num_walls, std::vector<WallLoad> &loads);
 
 } // namespace fibre
