@@ -143,12 +143,11 @@ std::vector<std::string> MaterialTable::describe() const
                          ", mu_roll " + g(p.mu_roll) + ", twisting ";
       line += p.twist == TwistLaw::sds        ? "sds " + g(p.twist_coeff)
               : p.twist == TwistLaw::marshall ? std::string("marshall")
-                                                     : std::string("none");
+                                              : std::string("none");
       line += ", restitution " + (p.restitution >= 0 ? g(p.restitution) : std::string("none"));
       lines.push_back(line);
     }
   return lines;
 }
-
 
 } // namespace fibre

@@ -141,6 +141,9 @@ std::size_t read_solver_keyword(const Reader &in, std::size_t i, StepOptions &op
     opt.sweeps = static_cast<int>(in.integer(i + 1, "'sweeps <non-negative integer>'", 0, 100000));
   else if (key == "sweep_tol")
     opt.sweep_tol = in.positive(i + 1, "'sweep_tol <positive number>'");
+  else if (key == "rescue_sweeps")
+    opt.rescue_sweeps =
+        static_cast<int>(in.integer(i + 1, "'rescue_sweeps <non-negative integer>'", 0, 1000000));
   else if (key == "sweep_cg") {
     if (!in.has(i + 1) || (in.at(i + 1) != "yes" && in.at(i + 1) != "no"))
       Reader::illegal("'sweep_cg yes|no'", in.has(i + 1) ? &in.at(i + 1) : nullptr);
@@ -256,11 +259,12 @@ Settings parse_settings(const std::vector<std::string> &args)
       used = 3;
     }
     if (!used)
-      Reader::illegal("a keyword (form, solver, precond, weight, tol, pass_tol, maxiter, "
-                      "compliance, damping, mu, mu_roll, mu_twist, rows, active_set, sweeps, "
-                      "sweep_tol, sweep_cg, recovery_speed, restitution, bounce_speed, "
-                      "coefficients, wall, export)",
-                      &key);
+      Reader::illegal(
+          "a keyword (form, solver, precond, weight, tol, pass_tol, maxiter, "
+          "compliance, damping, mu, mu_roll, mu_twist, rows, active_set, sweeps, "
+          "sweep_tol, rescue_sweeps, sweep_cg, recovery_speed, restitution, bounce_speed, "
+          "coefficients, wall, export)",
+          &key);
     i += used;
   }
   const FrictionParams &f = s.model.friction;

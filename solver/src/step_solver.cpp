@@ -20,6 +20,7 @@ std::string describe(const StepOptions &opt)
          ", tol " + g(opt.stop.tol) + ", pass_tol " + g(opt.pass_tol) + ", maxiter " +
          std::to_string(opt.stop.max_iter) + ", active_set " + std::to_string(opt.active_set_max) +
          ", sweeps " + std::to_string(opt.sweeps) + ", sweep_tol " + g(opt.sweep_tol) +
+         ", rescue_sweeps " + std::to_string(opt.rescue_sweeps) +
          (opt.sweep_cg ? ", sweep_cg yes" : "");
 }
 
@@ -277,6 +278,17 @@ void StepSolver::finish(Vector &lambda, StepResult &res) const
     res.sweep_reason = pr.reason;
     res.error_estimate = pr.error_estimate();
     res.complementarity = complementarity(sys_, ex_, cones_, b_full_, lambda, scale);
+    // far from sweep_tol at the cap: sweep on (collective: every process sees the residual)
+    if (pr.reason == StopReason::max_iterations && opt_.rescue_sweeps > res.sweeps &&
+        res.complementarity > kRescueFactor * opt_.sweep_tol) {
+      control.max_sweeps = opt_.rescue_sweeps - res.sweeps;
+      const PgsResult more = pgs(sys_, ex_, cones_, b_full_, scale, lambda, control);
+      res.sweeps += more.sweeps;
+      res.rescued = true;
+      res.sweep_reason = more.reason;
+      res.error_estimate = more.error_estimate();
+      res.complementarity = complementarity(sys_, ex_, cones_, b_full_, lambda, scale);
+    }
   }
   res.sweep_seconds = seconds_since(t_sweep);
 }
@@ -403,6 +415,12 @@ StepResult StepSolver::run(const Vector *warm)
       res.sweep_reason = again.sweep_reason;
       res.restarted = true;
     }
+  }
+  if (!sweeps_only() && res.converged && opt_.sweeps > 0 &&
+      res.complementarity > kRescueFactor * opt_.sweep_tol) {
+    res.converged = false;
+    res.reason =
+        res.sweep_reason == StopReason::converged ? StopReason::stagnation : res.sweep_reason;
   }
   if (sweeps_only() && res.complementarity > opt_.sweep_tol) {
     res.converged = false;

@@ -57,7 +57,8 @@ TEST(Settings, NoKeywordsKeepTheDefaults)
   EXPECT_EQ(s.export_every, 0);
   EXPECT_EQ(describe(s),
             "form body, solver cg, precond tree, weight z, tol 0.0001, pass_tol 0.001, maxiter "
-            "200, active_set 1, sweeps 50, sweep_tol 0.001, rows 6, damping 2, compliance auto "
+            "200, active_set 1, sweeps 50, sweep_tol 0.001, rescue_sweeps 500, rows 6, damping 2, "
+            "compliance auto "
             "(0.01 dt^2 / m_min), recovery_speed auto (0.01 r_min / dt), restitution 0, "
             "bounce_speed auto (2 dt |f| / m max, or 0.01 r_min / dt without forces), coefficients "
             "pair, mu 0.5, mu_roll 0, "
@@ -106,6 +107,8 @@ TEST(Settings, EveryKeywordSetsWhatItNames)
   EXPECT_EQ(s.export_prefix, "out/sys");
   EXPECT_NE(describe(s).find("compliance 1e-07 2e-07"), std::string::npos);
   EXPECT_EQ(parse_settings(words("solver pgs")).step.solver, Method::pgs);
+  EXPECT_EQ(parse_settings(words("rescue_sweeps 0")).step.rescue_sweeps, 0);
+  EXPECT_EQ(parse_settings(words("rescue_sweeps 2000")).step.rescue_sweeps, 2000);
   EXPECT_DOUBLE_EQ(parse_settings(words("recovery_speed 0.3")).model.recovery_speed, 0.3);
   EXPECT_DOUBLE_EQ(parse_settings(words("recovery_speed none")).model.recovery_speed, 0.0);
   const ContactModel automatic = parse_settings(words("recovery_speed auto")).model;

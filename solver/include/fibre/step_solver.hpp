@@ -40,9 +40,16 @@ struct StepOptions {
   // With solver pgs the sweeps are the whole solve.
   int sweeps = 50;
   double sweep_tol = 1e-3;
+  // A step whose sweeps end at their cap more than kRescueFactor times above sweep_tol (a
+  // jammed pack: a grain pinched between a moving blade and a wall was thrown at 1.7 m/s)
+  // sweeps on, up to this many sweeps in all (0: no rescue). Only such steps pay for it. A step
+  // still that far above sweep_tol after it counts as not converged.
+  int rescue_sweeps = 500;
   // The sweeps accelerated by nonsmooth nonlinear CG (always with solver nncg).
   bool sweep_cg = false;
 };
+
+inline constexpr double kRescueFactor = 10.0;
 
 // The settings as one line, "name value, name value, ..." (PETSc KSPView style): the front
 // ends log it, and the doc page's defaults are this line for StepOptions{}.
@@ -56,15 +63,18 @@ struct StepResult {
   int total_iterations = 0;
   double rel_residual = 0; // of the last linear solve: true ||b - A x|| / ||b|| in its form
   StopReason reason = StopReason::converged; // first failed solve's reason, else converged
-  bool converged = true;                     // every linear solve converged
-  int active_set_passes = 0;                 // linear solves done (1 .. active_set_max)
-  bool set_settled = false;                  // the active set and its caps settled (see cap_tol)
-  int released = 0;                          // contacts with zero impulse at the end (lambda_n < 0)
-  int capped = 0; // friction/rolling/twisting rows on their cone boundary
+  // every linear solve converged, and the step ended within kRescueFactor of sweep_tol (of it
+  // with solver pgs or nncg)
+  bool converged = true;
+  int active_set_passes = 0; // linear solves done (1 .. active_set_max)
+  bool set_settled = false;  // the active set and its caps settled (see cap_tol)
+  int released = 0;          // contacts with zero impulse at the end (lambda_n < 0)
+  int capped = 0;            // friction/rolling/twisting rows on their cone boundary
   // Relative residual of the contact conditions at the final lambda (see complementarity()
   // in contact_solver.cpp): 0 for an exact solution of the nonsmooth step.
   double complementarity = 0;
-  int sweeps = 0; // projected Gauss-Seidel sweeps done after the loop
+  int sweeps = 0;       // projected Gauss-Seidel sweeps done after the loop, rescue included
+  bool rescued = false; // the sweeps went on past opt.sweeps (StepOptions::rescue_sweeps)
   // The linear passes left the step worse than its warm start (complementarity residual), so
   // the sweeps started again from the warm start and their result was kept.
   bool restarted = false;
