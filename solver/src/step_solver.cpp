@@ -278,9 +278,10 @@ void StepSolver::finish(Vector &lambda, StepResult &res) const
     res.sweep_reason = pr.reason;
     res.error_estimate = pr.error_estimate();
     res.complementarity = complementarity(sys_, ex_, cones_, b_full_, lambda, scale);
-    // far from sweep_tol at the cap: sweep on (collective: every process sees the residual)
-    if (pr.reason == StopReason::max_iterations && opt_.rescue_sweeps > res.sweeps &&
-        res.complementarity > kRescueFactor * opt_.sweep_tol) {
+    // far from sweep_tol at the cap: sweep on (collective: every process sees the residual);
+    // with solver pgs or nncg the sweeps are the whole solve the user asked for
+    if (!sweeps_only() && pr.reason == StopReason::max_iterations &&
+        opt_.rescue_sweeps > res.sweeps && res.complementarity > kRescueFactor * opt_.sweep_tol) {
       control.max_sweeps = opt_.rescue_sweeps - res.sweeps;
       const PgsResult more = pgs(sys_, ex_, cones_, b_full_, scale, lambda, control);
       res.sweeps += more.sweeps;

@@ -548,3 +548,44 @@ TEST(ContactSolver, SweepsFinishAnUnsettledLoop)
     EXPECT_LE(swept.lambda.segment(rows * c + 1, 2).norm(), 0.4 * ln * (1 + 1e-12));
   }
 }
+
+// A step whose sweeps end at their cap far above sweep_tol sweeps on (rescue_sweeps); without
+// the rescue it counts as not converged.
+TEST(ContactSolver, RescueSweepsFinishAStepFarFromItsTolerance)
+{
+  SceneParams p;
+  p.seed = 11;
+  ContactSystem sys = pile_scene(80, p);
+  sys.set_friction(FrictionParams{0.4, 0.02, 0.0});
+  StepOptions ref_opt = base_options();
+  ref_opt.solver = Method::direct;
+  ref_opt.active_set_max = 60;
+  const StepResult ref = solve(sys, ref_opt);
+
+  StepOptions o = base_options();
+  o.solver = Method::cr;
+  o.active_set_max = 1;
+  o.sweeps = 3;
+  o.sweep_tol = 1e-3;
+  o.rescue_sweeps = 0;
+  const StepResult cut = solve(sys, o);
+  ASSERT_GT(cut.complementarity, kRescueFactor * o.sweep_tol);
+  EXPECT_FALSE(cut.converged);
+  EXPECT_FALSE(cut.rescued);
+  EXPECT_EQ(cut.sweeps, 3);
+
+  o.rescue_sweeps = 500;
+  const StepResult rescued = solve(sys, o);
+  EXPECT_TRUE(rescued.rescued);
+  EXPECT_TRUE(rescued.converged);
+  EXPECT_GT(rescued.sweeps, 3);
+  EXPECT_LE(rescued.sweeps, 500);
+  EXPECT_LT(rescued.complementarity, kRescueFactor * o.sweep_tol);
+  EXPECT_LT(rel_diff(rescued.dv, ref.dv), 0.1 * rel_diff(cut.dv, ref.dv))
+      << "cut " << rel_diff(cut.dv, ref.dv) << ", rescued " << rel_diff(rescued.dv, ref.dv);
+
+  // A step that ends within the factor is left as it is.
+  o.sweeps = 500;
+  const StepResult plain = solve(sys, o);
+  EXPECT_FALSE(plain.rescued);
+}

@@ -43,7 +43,8 @@ struct StepOptions {
   // A step whose sweeps end at their cap more than kRescueFactor times above sweep_tol (a
   // jammed pack: a grain pinched between a moving blade and a wall was thrown at 1.7 m/s)
   // sweeps on, up to this many sweeps in all (0: no rescue). Only such steps pay for it. A step
-  // still that far above sweep_tol after it counts as not converged.
+  // still that far above sweep_tol after it counts as not converged. Not with solver pgs or
+  // nncg, whose sweeps are the whole solve.
   int rescue_sweeps = 500;
   // The sweeps accelerated by nonsmooth nonlinear CG (always with solver nncg).
   bool sweep_cg = false;
