@@ -45,6 +45,10 @@ def run_deck(args, exe, workdir, deck, log, np=1, variables=None):
     return proc.returncode, proc.stdout.decode("utf-8", "replace")
 
 
+def failure(rc, out):
+    return "rc %d" % rc + ("" if rc == 0 else ", " + out[-300:])
+
+
 def native_liggghts():
     for path in ("/usr/bin/liggghts", shutil.which("liggghts") or ""):
         if path and os.path.exists(path):
@@ -64,7 +68,7 @@ def hopper(args, checks):
     for name, exe, deck, np in runs:
         log = os.path.join(workdir, "log." + name.replace(" ", "_"))
         rc, out = run_deck(args, exe, workdir, deck, log, np, small)
-        if not checks.check(rc == 0, "hopper %s completes" % name, "rc %d %s" % (rc, out[-300:])):
+        if not checks.check(rc == 0, "hopper %s completes" % name, failure(rc, out)):
             continue
         blocks, _ = compare.parse(log)
         escaped = max(compare.joined(blocks, "nesc"))
@@ -88,7 +92,7 @@ def mixer(args, checks):
         log = os.path.join(workdir, "log.np%d" % np)
         rc, out = run_deck(args, args.lmp, workdir, "in.mixer.fibre", log, np,
                            {"revs": 0.5, "tsettle": 0.3})
-        if not checks.check(rc == 0, "mixer np %d completes" % np, "rc %d %s" % (rc, out[-300:])):
+        if not checks.check(rc == 0, "mixer np %d completes" % np, failure(rc, out)):
             continue
         figures = compare.mixer(log)
         checks.check(figures["atoms_min"] == 1200 and figures["nout_max"] == 0,
