@@ -3,6 +3,8 @@
 // triangles, with their node velocities, go into a grid of the library's (fibre/mesh.hpp); each
 // owned sphere keeps one contact per face, edge or vertex it touches, keyed by the triangle's
 // global ID (warm starts follow the triangle). A LAMMPS region needs the LAMMPS front end.
+#include <mpi.h>
+
 #include <algorithm>
 #include <memory>
 #include <string>
@@ -23,6 +25,7 @@ namespace fibre_lmp {
 
 struct LammpsDetection::HostWalls {
   std::vector<FixMeshSurface *> meshes; // per wall, or nullptr
+  std::vector<bool> described;          // per wall: its triangles and open edges logged
   mutable std::vector<fibre::Triangle> triangles;
   mutable fibre::TriangleGrid grid;
   mutable std::vector<fibre::TriangleHit> hits;
@@ -40,6 +43,7 @@ void LammpsDetection::init_host_wall(int w)
 {
   if (!host_walls_) host_walls_ = std::make_unique<HostWalls>();
   host_walls_->meshes.resize(walls_.size(), nullptr);
+  host_walls_->described.assign(walls_.size(), false);
   const std::string &id = walls_[w].id;
   if (walls_[w].kind == fibre::WallKind::region)
     fail(error, FLERR,
@@ -59,8 +63,11 @@ void LammpsDetection::init_host_wall(int w)
   host_walls_->meshes[w] = static_cast<FixMeshSurface *>(fix);
 }
 
-// fix move/mesh moves the nodes itself and sets their velocities; nothing to record here.
-void LammpsDetection::start_moving_walls() {}
+// fix move/mesh moves the nodes itself and sets their velocities; each run logs its meshes.
+void LammpsDetection::start_moving_walls()
+{
+  if (host_walls_) host_walls_->described.assign(walls_.size(), false);
+}
 
 namespace {
 
@@ -84,6 +91,41 @@ void read_triangles(TriMesh *mesh, std::vector<fibre::Triangle> &out)
   }
 }
 
+// The whole mesh on process 0 (every process's local triangles): its size and open edges for
+// the log, once per run. Collective.
+void describe_mesh(LAMMPS *lmp, TriMesh *mesh, const std::string &id)
+{
+  const int nlocal = mesh->sizeLocal();
+  std::vector<double> mine(9 * std::size_t(nlocal));
+  for (int t = 0; t < nlocal; ++t)
+    for (int j = 0; j < 3; ++j) mesh->node(t, j, &mine[9 * std::size_t(t) + 3 * j]);
+  int nprocs = 1, me = 0;
+  MPI_Comm_size(lmp->world, &nprocs);
+  MPI_Comm_rank(lmp->world, &me);
+  const int count = 9 * nlocal;
+  std::vector<int> counts(nprocs), offsets(nprocs, 0);
+  MPI_Gather(&count, 1, MPI_INT, counts.data(), 1, MPI_INT, 0, lmp->world);
+  for (int p = 1; p < nprocs; ++p) offsets[p] = offsets[p - 1] + counts[p - 1];
+  std::vector<double> all(me == 0 ? std::size_t(offsets.back() + counts.back()) : 0);
+  MPI_Gatherv(mine.data(), count, MPI_DOUBLE, all.data(), counts.data(), offsets.data(), MPI_DOUBLE,
+              0, lmp->world);
+  if (me != 0) return;
+  std::vector<fibre::Triangle> tris(all.size() / 9);
+  double edges = 0.0;
+  for (std::size_t t = 0; t < tris.size(); ++t)
+    for (int j = 0; j < 3; ++j) {
+      const double *p = &all[9 * t + 3 * j];
+      tris[t].p[j] = fibre::Vec3(p[0], p[1], p[2]);
+    }
+  for (const fibre::Triangle &tri : tris) edges += (tri.p[1] - tri.p[0]).norm();
+  const double tol = tris.empty() ? 1.0 : 1e-6 * edges / double(tris.size());
+  const int open = fibre::open_edges(tris, tol);
+  logmesg(lmp, "fix fibre_contact: wall mesh " + id + ": " + std::to_string(tris.size()) +
+                   " triangles, " + std::to_string(open) +
+                   (open ? " open edges (rims or holes: grains can leave there)\n"
+                         : " open edges (a closed surface)\n"));
+}
+
 } // namespace
 
 void LammpsDetection::host_wall_contacts(int w, const std::vector<fibre::Body> &bodies, double h,
@@ -92,6 +134,10 @@ void LammpsDetection::host_wall_contacts(int w, const std::vector<fibre::Body> &
 {
   HostWalls &host = *host_walls_;
   FixMeshSurface *fix = host.meshes[w];
+  if (!host.described[w]) {
+    describe_mesh(lmp, fix->triMesh(), walls_[w].id);
+    host.described[w] = true;
+  }
   read_triangles(fix->triMesh(), host.triangles);
   if (host.triangles.empty()) return;
   double speed = 0.0; // the fastest node bounds the surface speed near any sphere

@@ -3,7 +3,10 @@
 #include <cmath>
 
 #include <algorithm>
+#include <array>
 #include <limits>
+#include <map>
+#include <utility>
 
 namespace fibre {
 
@@ -277,6 +280,26 @@ int mesh_hits(const std::vector<Triangle> &tris, const TriangleGrid &grid, const
     if (!duplicate) hits.push_back(hit);
   }
   return static_cast<int>(hits.size() - first);
+}
+
+int open_edges(const std::vector<Triangle> &tris, double tol)
+{
+  using Node = std::array<long long, 3>;
+  const auto node = [tol](const Vec3 &p) {
+    return Node{std::llround(p.x() / tol), std::llround(p.y() / tol), std::llround(p.z() / tol)};
+  };
+  std::map<std::pair<Node, Node>, int> uses;
+  for (const Triangle &t : tris)
+    for (int j = 0; j < 3; ++j) {
+      Node a = node(t.p[j]), b = node(t.p[(j + 1) % 3]);
+      if (a == b) continue; // a degenerate edge bounds nothing
+      if (b < a) std::swap(a, b);
+      ++uses[{a, b}];
+    }
+  int open = 0;
+  for (const auto &edge : uses)
+    if (edge.second == 1) ++open;
+  return open;
 }
 
 } // namespace fibre

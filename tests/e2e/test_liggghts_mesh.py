@@ -203,6 +203,8 @@ def cube_drop(args, checks):
     checks.check(closest >= 0.999 * R, "spheres dropped on a cube mesh's face, edges and "
                  "corner never enter it", "closest centre %.4g r" % (closest / R))
     checks.check(run.last("KinEng") < 1e-6, "they come to rest", "KE %g" % run.last("KinEng"))
+    checks.check("wall mesh box: 12 triangles, 0 open edges (a closed surface)" in run.output,
+                 "the log describes the cube mesh as closed")
 
 
 def pile_deck(np_grid=None):
@@ -229,6 +231,8 @@ def parallel_and_restart(args, checks):
                        np=2)
     if checks.ran(serial) and checks.ran(para):
         checks.check(serial.last("Atoms") == para.last("Atoms"), "np 2 keeps every sphere")
+        checks.check("wall mesh box: 10 triangles, 4 open edges" in para.output,
+                     "np 2: the log counts the open box's 4 open edges over both processes")
         for col in ("c[1]", "c[2]", "c[3]"):
             checks.check(abs(serial.last(col) - para.last(col)) < 1e-9,
                          "np 2: centre of mass %s as in serial" % col,

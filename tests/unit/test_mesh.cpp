@@ -368,3 +368,30 @@ TEST(Mesh, DegenerateTrianglesStayFinite)
   grid.candidates(p + Vec3(0.1, 0, 0), 0.2, cand);
   EXPECT_EQ(cand, std::vector<int>{0});
 }
+
+// Open edges: a closed cube has none; without its lid, the lid's 4 edges; a flat square of two
+// triangles its 4 sides; nodes matched within the tolerance.
+TEST(Mesh, OpenEdgesOfClosedAndOpenMeshes)
+{
+  const Vec3 v[8] = {{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0},
+                     {0, 0, 1}, {1, 0, 1}, {1, 1, 1}, {0, 1, 1}};
+  const int quads[6][4] = {{0, 3, 2, 1}, {4, 5, 6, 7}, {0, 1, 5, 4},
+                           {2, 3, 7, 6}, {1, 2, 6, 5}, {3, 0, 4, 7}};
+  std::vector<Triangle> cube;
+  for (const auto &q : quads) {
+    Triangle a, b;
+    a.p[0] = v[q[0]], a.p[1] = v[q[1]], a.p[2] = v[q[2]];
+    b.p[0] = v[q[0]], b.p[1] = v[q[2]], b.p[2] = v[q[3]];
+    cube.push_back(a);
+    cube.push_back(b);
+  }
+  EXPECT_EQ(open_edges(cube, 1e-9), 0);
+  std::vector<Triangle> open_box(cube.begin(), cube.end());
+  open_box.erase(open_box.begin() + 2, open_box.begin() + 4); // the lid, z = 1
+  EXPECT_EQ(open_edges(open_box, 1e-9), 4);
+  std::vector<Triangle> square(cube.begin(), cube.begin() + 2); // the floor
+  EXPECT_EQ(open_edges(square, 1e-9), 4);
+  // a node off by less than the tolerance is the same node
+  square[1].p[0] += Vec3(1e-12, 0, 0);
+  EXPECT_EQ(open_edges(square, 1e-9), 4);
+}

@@ -77,4 +77,9 @@ class TriangleGrid {
 int mesh_hits(const std::vector<Triangle> &tris, const TriangleGrid &grid, const Vec3 &x,
               double reach, std::vector<TriangleHit> &hits);
 
+// Edges used by one triangle only: a mesh's rims and holes, where grains can leave (a closed
+// surface has none). Nodes are matched by rounding their coordinates to multiples of tol; an
+// edge of three or more triangles counts as closed.
+int open_edges(const std::vector<Triangle> &tris, double tol);
+
 } // namespace fibre
