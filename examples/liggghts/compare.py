@@ -4,6 +4,8 @@
     compare.py report LOG [LOG...]   hopper: steady discharge rate, wall time; one row per log
     compare.py mixer  LOG [LOG...]   mixer: mean kinetic energy, torque and power of the blade
                                      over the rotation phase, lost spheres, wall time
+    compare.py heap   DUMP [DUMP...] heap: angle of repose and height from the final dump
+                                     (id x y z radius) of the heap scene
 
 LOG is a LIGGGHTS log (log.liggghts or the file given to -log). Options:
     --plot FILE.png   also plot the logs (hopper: spheres in the hopper against the time since
@@ -196,6 +198,47 @@ def mixer(path):
     }
 
 
+def heap(path, plate=0.05, bin_width=0.0025, lo=0.2, hi=0.8):
+    """The heap's surface from a dump: in radial bins of bin_width over the plate, the highest
+    sphere top (z + radius); the height H is the highest top. Two angles of repose: the
+    fixed-base angle atan(H / plate) of a heap that spills over the plate's rim, and the slope
+    of a straight line fitted to the tops of the bins between lo H and hi H."""
+    with open(path) as f:
+        lines = f.read().splitlines()
+    i = next(k for k, ln in enumerate(lines) if ln.startswith("ITEM: ATOMS"))
+    names = lines[i].split()[2:]
+    rows = [[float(w) for w in ln.split()] for ln in lines[i + 1:] if ln.strip()]
+    a = np.array(rows)
+    x, y, z, r = (a[:, names.index(n)] for n in ("x", "y", "z", "radius"))
+    rad = np.hypot(x, y)
+    on = (rad < plate) & (z > -0.001)
+    tops = []
+    for b in range(int(plate / bin_width)):
+        sel = on & (rad >= b * bin_width) & (rad < (b + 1) * bin_width)
+        if sel.any():
+            tops.append(((b + 0.5) * bin_width, float((z[sel] + r[sel]).max())))
+    t = np.array(tops)
+    height = t[:, 1].max()
+    flank = (t[:, 1] >= lo * height) & (t[:, 1] <= hi * height)
+    slope, _, r2 = fit(t[flank, 0], t[flank, 1])
+    return {"dump": path, "spheres": int(on.sum()), "height": height,
+            "angle": math.degrees(math.atan(-slope)), "r2": r2, "bins": int(flank.sum()),
+            "fixed_base": math.degrees(math.atan(height / plate))}
+
+
+def cmd_heap(a):
+    rows = []
+    for path in a.dumps:
+        h = heap(path)
+        rows.append([h["dump"], str(h["spheres"]), g(1000 * h["height"], "%.1f"),
+                     g(h["fixed_base"], "%.1f"), g(h["angle"], "%.1f"), str(h["bins"]),
+                     g(h["r2"], "%.3f")])
+    print(table(["dump", "spheres on the plate", "height H (mm)",
+                 "angle atan(H / R_plate) (deg)", "flank fit angle (deg)", "flank bins",
+                 "flank R^2"], rows))
+    return 0
+
+
 def g(x, fmt="%.4g"):
     return "" if x is None or (isinstance(x, float) and math.isnan(x)) else fmt % x
 
@@ -288,6 +331,9 @@ def main(argv=None):
     p.add_argument("logs", nargs="+")
     p.add_argument("--plot")
     p.set_defaults(func=cmd_mixer)
+    p = sub.add_parser("heap", help="heap angle of repose and height from final dumps")
+    p.add_argument("dumps", nargs="+")
+    p.set_defaults(func=cmd_heap)
     a = ap.parse_args(argv)
     return a.func(a) or 0
 
