@@ -1,5 +1,6 @@
-// What fix fibre_contact reports: the global vector f_ID[1..15], the local array (one row per
-// contact kept by this process), the non-convergence warnings and the system exports.
+// What fix fibre_contact reports: the global vector f_ID[1..18], the wall loads f_ID[w][1..6],
+// the local array (one row per contact kept by this process), the non-convergence warnings and
+// the system exports.
 #pragma once
 
 #include <string>
