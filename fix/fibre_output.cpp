@@ -77,9 +77,9 @@ void FibreOutput::report_solve(const fibre::StepResult &res)
              "Fix fibre_contact: contact solve did not converge at step " +
                  std::to_string(static_cast<long long>(step)) + " (" +
                  fibre::to_string(res.reason) + ", " + std::to_string(res.iterations) +
-                 " iterations, relative "
-                 "residual " +
-                 fibre::format_g(res.rel_residual) + "); " +
+                 " iterations, relative residual " + fibre::format_g(res.rel_residual) + ", " +
+                 std::to_string(res.sweeps) + " sweeps, complementarity " +
+                 fibre::format_g(res.complementarity) + "); " +
                  std::to_string(static_cast<long long>(nonconverged_since_warning_)) +
                  " non-converged steps since the last warning, " +
                  std::to_string(static_cast<long long>(nonconverged_total_)) + " in all");
