@@ -42,6 +42,7 @@ while [ $# -gt 0 ]; do
   esac
 done
 [ -x "$lmp" ] || { echo "$(basename "$0"): no LAMMPS binary $lmp (--lmp)" >&2; exit 2; }
+lmp=$(cd "$(dirname "$lmp")" && pwd)/$(basename "$lmp") # the runs cd into the work directory
 export OMP_NUM_THREADS=1
 mkdir -p "$work"
 work=$(cd "$work" && pwd)

@@ -350,6 +350,7 @@ SolveResult krylov_solve(Method m, const LinearOperator &A, const Preconditioner
   case Method::direct:
   case Method::pgs:
   case Method::nncg:
+  case Method::fbgs:
     break;
   }
   throw std::invalid_argument(std::string("krylov_solve: ") + to_string(m) +

@@ -2,8 +2,10 @@
 
 #include <array>
 #include <cmath>
+#include <memory>
 
 #include "fibre/contact_rows.hpp"
+#include "fibre/fibre_blocks.hpp"
 #include "fibre/spook.hpp"
 
 namespace fibre {
@@ -79,10 +81,20 @@ PgsResult pgs(const ContactSystem &sys, const Exchange &ex, const Cones &cones, 
   Vector direction, change; // nonlinear CG
   double last_change2 = 0;
   std::vector<double> changes; // relative change per sweep
+  std::unique_ptr<FibreBlocks> blocks;
+  if (control.fibre_blocks) {
+    for (int c = 0; c < nc; ++c) cones.project(lambda.data() + Eigen::Index(rows) * c, c);
+    dv = velocity_change(sys, ex, lambda);
+    Vector normal(nc);
+    for (int c = 0; c < nc; ++c) normal[c] = lambda[Eigen::Index(rows) * c];
+    blocks =
+        std::make_unique<FibreBlocks>(sys, ex.local_owners(), cones, control.block_weight, &normal);
+  }
   for (int s = 0; s < control.max_sweeps; ++s) {
     // dv follows this process's updates; `moved` collects them for the other processes.
     dv_start = dv;
     lambda_start = lambda;
+    if (blocks) blocks->correct(b, lambda, dv);
     double norms[2] = {0, 0}; // ||change||^2, ||lambda||^2
     if (rows == 6)
       sweep<6>(sys, cones, b, inv_scale, ex.local_owners(), lambda, dv, norms);

@@ -148,6 +148,10 @@ std::size_t read_solver_keyword(const Reader &in, std::size_t i, StepOptions &op
     if (!in.has(i + 1) || (in.at(i + 1) != "yes" && in.at(i + 1) != "no"))
       Reader::illegal("'sweep_cg yes|no'", in.has(i + 1) ? &in.at(i + 1) : nullptr);
     opt.sweep_cg = in.at(i + 1) == "yes";
+  } else if (key == "sweep_blocks") {
+    if (!in.has(i + 1) || (in.at(i + 1) != "yes" && in.at(i + 1) != "no"))
+      Reader::illegal("'sweep_blocks yes|no'", in.has(i + 1) ? &in.at(i + 1) : nullptr);
+    opt.sweep_blocks = in.at(i + 1) == "yes";
   } else
     return 0;
   return 2;
@@ -259,12 +263,12 @@ Settings parse_settings(const std::vector<std::string> &args)
       used = 3;
     }
     if (!used)
-      Reader::illegal(
-          "a keyword (form, solver, precond, weight, tol, pass_tol, maxiter, "
-          "compliance, damping, mu, mu_roll, mu_twist, rows, active_set, sweeps, "
-          "sweep_tol, rescue_sweeps, sweep_cg, recovery_speed, restitution, bounce_speed, "
-          "coefficients, wall, export)",
-          &key);
+      Reader::illegal("a keyword (form, solver, precond, weight, tol, pass_tol, maxiter, "
+                      "compliance, damping, mu, mu_roll, mu_twist, rows, active_set, sweeps, "
+                      "sweep_tol, rescue_sweeps, sweep_cg, sweep_blocks, recovery_speed, "
+                      "restitution, bounce_speed, "
+                      "coefficients, wall, export)",
+                      &key);
     i += used;
   }
   const FrictionParams &f = s.model.friction;

@@ -21,7 +21,7 @@ std::string describe(const StepOptions &opt)
          std::to_string(opt.stop.max_iter) + ", active_set " + std::to_string(opt.active_set_max) +
          ", sweeps " + std::to_string(opt.sweeps) + ", sweep_tol " + g(opt.sweep_tol) +
          ", rescue_sweeps " + std::to_string(opt.rescue_sweeps) +
-         (opt.sweep_cg ? ", sweep_cg yes" : "");
+         (opt.sweep_cg ? ", sweep_cg yes" : "") + (opt.sweep_blocks ? ", sweep_blocks yes" : "");
 }
 
 namespace {
@@ -55,7 +55,10 @@ class StepSolver {
   void active_set_loop(Vector &lambda, StepResult &res);
 
   double coeff(int c, int k) const { return cones_.coeff(c, k); }
-  bool sweeps_only() const { return opt_.solver == Method::pgs || opt_.solver == Method::nncg; }
+  bool sweeps_only() const
+  {
+    return opt_.solver == Method::pgs || opt_.solver == Method::nncg || opt_.solver == Method::fbgs;
+  }
   Eigen::Index base(int c) const { return Eigen::Index(rows_) * c; }
   std::vector<unsigned char> active_mask() const;
   Vector fixed_impulses(const Vector &lambda) const;
@@ -268,27 +271,29 @@ void StepSolver::finish(Vector &lambda, StepResult &res) const
 {
   const auto t_sweep = Clock::now();
   const std::vector<Vec6> &scale = row_scales_;
+  res.sweeps = 0;
   res.complementarity = complementarity(sys_, ex_, cones_, b_full_, lambda, scale);
   res.error_estimate = res.complementarity;
   if (opt_.sweeps > 0 && res.complementarity > opt_.sweep_tol) {
     PgsControl control{opt_.sweeps, opt_.sweep_tol};
     control.nonlinear_cg = opt_.sweep_cg || opt_.solver == Method::nncg;
-    const PgsResult pr = pgs(sys_, ex_, cones_, b_full_, scale, lambda, control);
-    res.sweeps = pr.sweeps;
-    res.sweep_reason = pr.reason;
-    res.error_estimate = pr.error_estimate();
-    res.complementarity = complementarity(sys_, ex_, cones_, b_full_, lambda, scale);
+    control.fibre_blocks = opt_.sweep_blocks || opt_.solver == Method::fbgs;
+    control.block_weight = opt_.precond.weight;
+    const auto sweep = [&]() {
+      const PgsResult pr = pgs(sys_, ex_, cones_, b_full_, scale, lambda, control);
+      res.sweeps += pr.sweeps;
+      res.sweep_reason = pr.reason;
+      res.error_estimate = pr.error_estimate();
+      res.complementarity = complementarity(sys_, ex_, cones_, b_full_, lambda, scale);
+    };
+    sweep();
     // far from sweep_tol at the cap: sweep on (collective: every process sees the residual);
-    // with solver pgs or nncg the sweeps are the whole solve the user asked for
-    if (!sweeps_only() && pr.reason == StopReason::max_iterations &&
+    // with a sweeps-only solver the sweeps are the whole solve the user asked for
+    if (!sweeps_only() && res.sweep_reason == StopReason::max_iterations &&
         opt_.rescue_sweeps > res.sweeps && res.complementarity > kRescueFactor * opt_.sweep_tol) {
       control.max_sweeps = opt_.rescue_sweeps - res.sweeps;
-      const PgsResult more = pgs(sys_, ex_, cones_, b_full_, scale, lambda, control);
-      res.sweeps += more.sweeps;
       res.rescued = true;
-      res.sweep_reason = more.reason;
-      res.error_estimate = more.error_estimate();
-      res.complementarity = complementarity(sys_, ex_, cones_, b_full_, lambda, scale);
+      sweep();
     }
   }
   res.sweep_seconds = seconds_since(t_sweep);

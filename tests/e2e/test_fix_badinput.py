@@ -46,7 +46,7 @@ CASES = [
     ("form_invalid", "form primal", "expected 'form body|contact', got 'primal'", {}),
     ("form_missing", "form", "expected 'form body|contact'", {}),
     # the choices are Method's name table: cg (uzawa an accepted alias), cr, minres, direct, pgs
-    ("solver_invalid", "solver bicgstab", "expected 'solver cg|cr|minres|direct|pgs|nncg', got "
+    ("solver_invalid", "solver bicgstab", "expected 'solver cg|cr|minres|direct|pgs|nncg|fbgs', got "
      "'bicgstab'", {}),
     ("precond_invalid", "precond ilu", "expected 'precond none|jacobi|block|fibre|tree', got "
      "'ilu'", {}),
@@ -60,6 +60,7 @@ CASES = [
     ("sweeps_real", "sweeps 2.5", "expected 'sweeps <non-negative integer>', got '2.5'", {}),
     ("sweep_tol_zero", "sweep_tol 0", "expected 'sweep_tol <positive number>', got '0'", {}),
     ("sweep_tol_missing", "sweep_tol", "expected 'sweep_tol <positive number>'", {}),
+    ("sweep_blocks_word", "sweep_blocks maybe", "expected 'sweep_blocks yes|no', got 'maybe'", {}),
     ("maxiter_zero", "maxiter 0", "expected 'maxiter <positive integer>', got '0'", {}),
     ("maxiter_real", "maxiter 2.5", "expected 'maxiter <positive integer>', got '2.5'", {}),
     ("compliance_one", "compliance 1e-6",

@@ -3,8 +3,10 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
 #include <limits>
 
+#include "fibre/nonsmooth_reference.hpp"
 #include "fibre/pgs.hpp"
 #include "fibre/scenes.hpp"
 #include "fibre/spook.hpp"
@@ -177,4 +179,82 @@ TEST(Pgs, PeriodicImagesAreOneBody)
   EXPECT_LT(error_after(200), 1e-6); // the same fixed point
   const double apart = error_after(8);
   EXPECT_LT(in_place, 0.1 * apart) << in_place << " " << apart;
+}
+
+namespace {
+
+// A column of n spheres (radius 0.5) on a floor, its contacts listed from the top down: the
+// order in which point sweeps carry the load down most slowly.
+ContactSystem column(int n)
+{
+  std::vector<Body> bodies(n);
+  for (int k = 0; k < n; ++k) {
+    bodies[k].radius = 0.5;
+    bodies[k].mass = 0.5;
+    bodies[k].x = Vec3(0, 0, 0.5 + k);
+    bodies[k].force = Vec3(0.1, 0, -9.81 * bodies[k].mass);
+  }
+  std::vector<Contact> contacts;
+  for (int k = n - 1; k > 0; --k) contacts.push_back(sphere_sphere_contact(bodies, k, k - 1));
+  contacts.push_back(sphere_wall_contact(bodies, 0, Vec3::UnitZ(), 0.5));
+  for (Contact &c : contacts) {
+    c.compliance.fill(1e-9);
+    c.friction = FrictionParams{0.5, 0.1, 0.05};
+  }
+  SpookParams spook;
+  spook.h = 1e-3;
+  return ContactSystem(bodies, contacts, 6, spook);
+}
+
+} // namespace
+
+// Fibre-block Gauss-Seidel: the column is one block (its chain and the floor), solved exactly
+// by its corrections, where point sweeps crawl.
+TEST(FibreBlocks, SolveAColumnInAFewSweeps)
+{
+  const ContactSystem sys = column(30);
+  const Vector b = spook_rhs(sys);
+  const Cones cones(sys);
+  const std::vector<Vec6> scale = row_scales(sys);
+  const Reference ref = nonsmooth_reference(sys, Vector::Zero(sys.contact_dofs()));
+  // Point sweeps crawl here (a contraction near 1): their residual of 1e-10 is still 1e-4 off
+  // in velocity, so the reference is the semismooth Newton solution.
+  ASSERT_TRUE(ref.newton.converged);
+  PgsControl control{20000, 1e-10, 100000};
+  Vector point = Vector::Zero(sys.contact_dofs());
+  const PgsResult by_point = pgs(sys, serial_exchange(), cones, b, scale, point, control);
+  control.fibre_blocks = true;
+  control.block_weight = EdgeWeight::z;
+  Vector block = Vector::Zero(sys.contact_dofs());
+  const PgsResult by_block = pgs(sys, serial_exchange(), cones, b, scale, block, control);
+  EXPECT_TRUE(by_block.converged());
+  EXPECT_LE(by_block.sweeps, 50); // the rolling cones on their boundary follow lambda_n lagged
+  EXPECT_LT(step_accuracy(sys, block, ref.lambda).velocity(), 1e-8);
+  // 20,000 point sweeps (400 times as many) are still far off
+  EXPECT_EQ(by_point.sweeps, 20000);
+  EXPECT_GT(step_accuracy(sys, point, ref.lambda).velocity(), 1e-5);
+  std::printf("column: point sweeps %d, error %.3g; block sweeps %d, error %.3g\n", by_point.sweeps,
+              step_accuracy(sys, point, ref.lambda).velocity(), by_block.sweeps,
+              step_accuracy(sys, block, ref.lambda).velocity());
+}
+
+// On a pile with sliding and released contacts the corrections change the path, not the fixed
+// point: the same impulses as the reference.
+TEST(FibreBlocks, ConvergeToTheReferenceOnAPile)
+{
+  Problem pr = pile(200, 0.4);
+  const Cones cones(pr.sys);
+  const std::vector<Vec6> scale = row_scales(pr.sys);
+  const Reference ref = nonsmooth_reference(pr.sys, Vector::Zero(pr.sys.contact_dofs()));
+  ASSERT_TRUE(ref.confirmed());
+  for (EdgeWeight weight : {EdgeWeight::z, EdgeWeight::impulse}) {
+    PgsControl control{100000, 1e-12, 100000};
+    control.fibre_blocks = true;
+    control.block_weight = weight;
+    Vector lambda = Vector::Zero(pr.sys.contact_dofs());
+    const PgsResult res = pgs(pr.sys, serial_exchange(), cones, pr.b, scale, lambda, control);
+    EXPECT_TRUE(res.converged()) << to_string(weight);
+    EXPECT_LT(complementarity(pr.sys, serial_exchange(), cones, pr.b, lambda, scale), 1e-9);
+    EXPECT_LT(step_accuracy(pr.sys, lambda, ref.lambda).velocity(), 1e-6) << to_string(weight);
+  }
 }

@@ -107,6 +107,11 @@ TEST(Settings, EveryKeywordSetsWhatItNames)
   EXPECT_EQ(s.export_prefix, "out/sys");
   EXPECT_NE(describe(s).find("compliance 1e-07 2e-07"), std::string::npos);
   EXPECT_EQ(parse_settings(words("solver pgs")).step.solver, Method::pgs);
+  EXPECT_EQ(parse_settings(words("solver fbgs")).step.solver, Method::fbgs);
+  const Settings blocks = parse_settings(words("sweep_blocks yes"));
+  EXPECT_TRUE(blocks.step.sweep_blocks);
+  EXPECT_NE(describe(blocks.step).find("sweep_blocks yes"), std::string::npos);
+  EXPECT_FALSE(parse_settings(words("sweep_blocks no")).step.sweep_blocks);
   EXPECT_EQ(parse_settings(words("rescue_sweeps 0")).step.rescue_sweeps, 0);
   EXPECT_EQ(parse_settings(words("rescue_sweeps 2000")).step.rescue_sweeps, 2000);
   EXPECT_DOUBLE_EQ(parse_settings(words("recovery_speed 0.3")).model.recovery_speed, 0.3);
@@ -140,7 +145,7 @@ TEST(Settings, BadInputNamesTheKeywordAndItsForm)
 {
   EXPECT_EQ(error_of("form primal"), "expected 'form body|contact', got 'primal'");
   EXPECT_EQ(error_of("solver bicgstab"),
-            "expected 'solver cg|cr|minres|direct|pgs|nncg', got 'bicgstab'");
+            "expected 'solver cg|cr|minres|direct|pgs|nncg|fbgs', got 'bicgstab'");
   EXPECT_EQ(error_of("precond"), "expected 'precond none|jacobi|block|fibre|tree'");
   EXPECT_EQ(error_of("tol -1"), "expected 'tol <positive number>', got '-1'");
   EXPECT_EQ(error_of("tol 1e-3x"), "expected 'tol <positive number>', got '1e-3x'");

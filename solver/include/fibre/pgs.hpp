@@ -8,6 +8,7 @@
 
 #include "fibre/cones.hpp"
 #include "fibre/exchange.hpp"
+#include "fibre/fibres.hpp"
 #include "fibre/solver_control.hpp"
 
 namespace fibre {
@@ -23,6 +24,10 @@ struct PgsControl {
   // descent direction, and beta = |r_k+1|^2 / |r_k|^2 of the previous direction is added to it
   // (restarted when beta > 1); one extra G^T product per sweep.
   bool nonlinear_cg = false;
+  // Fibre-block corrections before every sweep (fibre_blocks.hpp), the fibres built with
+  // block_weight from the starting impulses.
+  bool fibre_blocks = false;
+  EdgeWeight block_weight = EdgeWeight::impulse;
 };
 
 inline constexpr int kRateWindow = 5;

@@ -48,6 +48,8 @@ struct StepOptions {
   int rescue_sweeps = 500;
   // The sweeps accelerated by nonsmooth nonlinear CG (always with solver nncg).
   bool sweep_cg = false;
+  // Fibre-block corrections before every sweep (always with solver fbgs).
+  bool sweep_blocks = false;
 };
 
 inline constexpr double kRescueFactor = 10.0;
