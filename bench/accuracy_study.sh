@@ -1,11 +1,12 @@
 #!/bin/bash
 # Accuracy against cost of the nonsmooth step: every state (a .sys/.lambda pair that
 # bench/export_states.sh or `fix fibre_contact export` wrote) is replayed by fibre_accuracy
-# with five families of settings, each against the state's converged reference (projected
+# with six families of settings, each against the state's converged reference (projected
 # Gauss-Seidel and semismooth Newton to a complementarity residual of 1e-10, cross-checked):
 #   pgs        solver pgs, S sweeps
 #   nncg       solver nncg (the sweeps with nonsmooth nonlinear CG), S sweeps
 #   fbgs       solver fbgs (the sweeps with fibre-block corrections), S sweeps
+#   apgd       solver apgd (accelerated projected gradient), S iterations
 #   default    the default linear pass (body form, tree-preconditioned CG) then S sweeps
 #   default+cg the same with the sweeps accelerated (sweep_cg yes)
 # for S in the list below (the default families without the rescue, which a sweep_tol of
@@ -39,6 +40,7 @@ for s in 5 10 20 50 100 200 500 1000; do
   settings+=(--setting "solver pgs sweeps $s sweep_tol 1e-14")
   settings+=(--setting "solver nncg sweeps $s sweep_tol 1e-14")
   settings+=(--setting "solver fbgs sweeps $s sweep_tol 1e-14")
+  settings+=(--setting "solver apgd sweeps $s sweep_tol 1e-14")
 done
 for s in 0 5 10 20 50 100 200 500; do
   settings+=(--setting "sweeps $s sweep_tol 1e-14 rescue_sweeps 0")

@@ -3,7 +3,7 @@
 
 One panel per state: the velocity-change error (the larger of the translational and the
 rotational relative errors) against the cost in K-product equivalents, one curve per family
-(pgs, nncg, fbgs, default, default+cg), the defaults marked. Prints, per state and family, the
+(pgs, nncg, fbgs, apgd, default, default+cg), the defaults marked. Prints, per state and family, the
 cheapest setting that reaches 1e-3 in velocity and 1e-2 in impulses, as bench/README.md shows.
 """
 
@@ -12,7 +12,7 @@ import csv
 import math
 import os
 
-FAMILIES = ["pgs", "nncg", "fbgs", "default", "default+cg"]
+FAMILIES = ["pgs", "nncg", "fbgs", "apgd", "default", "default+cg"]
 DEFAULT = "(defaults)"  # fibre_accuracy's name of the empty setting
 
 
@@ -23,6 +23,8 @@ def family(setting):
         return "nncg"
     if "solver fbgs" in setting:
         return "fbgs"
+    if "solver apgd" in setting:
+        return "apgd"
     if "sweep_cg yes" in setting:
         return "default+cg"
     return "default"
@@ -73,7 +75,7 @@ def main():
     cols = min(4, len(states))
     rows_n = math.ceil(len(states) / cols)
     fig, axes = plt.subplots(rows_n, cols, figsize=(4.2 * cols, 3.6 * rows_n), squeeze=False)
-    styles = {"pgs": "o-", "nncg": "s-", "fbgs": "d-", "default": "^-", "default+cg": "v-"}
+    styles = {"pgs": "o-", "nncg": "s-", "fbgs": "d-", "apgd": "x-", "default": "^-", "default+cg": "v-"}
     for ax, (name, rows) in zip(axes.flat, states):
         for fam in FAMILIES:
             pts = sorted((r["k_products"], r["velocity"]) for r in rows

@@ -351,6 +351,7 @@ SolveResult krylov_solve(Method m, const LinearOperator &A, const Preconditioner
   case Method::pgs:
   case Method::nncg:
   case Method::fbgs:
+  case Method::apgd:
     break;
   }
   throw std::invalid_argument(std::string("krylov_solve: ") + to_string(m) +

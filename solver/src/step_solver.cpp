@@ -3,6 +3,7 @@
 #include <cmath>
 #include <limits>
 
+#include "fibre/apgd.hpp"
 #include "fibre/cones.hpp"
 #include "fibre/direct.hpp"
 #include "fibre/kernels.hpp"
@@ -57,7 +58,8 @@ class StepSolver {
   double coeff(int c, int k) const { return cones_.coeff(c, k); }
   bool sweeps_only() const
   {
-    return opt_.solver == Method::pgs || opt_.solver == Method::nncg || opt_.solver == Method::fbgs;
+    return opt_.solver == Method::pgs || opt_.solver == Method::nncg ||
+           opt_.solver == Method::fbgs || opt_.solver == Method::apgd;
   }
   Eigen::Index base(int c) const { return Eigen::Index(rows_) * c; }
   std::vector<unsigned char> active_mask() const;
@@ -280,7 +282,9 @@ void StepSolver::finish(Vector &lambda, StepResult &res) const
     control.fibre_blocks = opt_.sweep_blocks || opt_.solver == Method::fbgs;
     control.block_weight = opt_.precond.weight;
     const auto sweep = [&]() {
-      const PgsResult pr = pgs(sys_, ex_, cones_, b_full_, scale, lambda, control);
+      const PgsResult pr = opt_.solver == Method::apgd
+                               ? apgd(sys_, ex_, cones_, b_full_, scale, lambda, control)
+                               : pgs(sys_, ex_, cones_, b_full_, scale, lambda, control);
       res.sweeps += pr.sweeps;
       res.sweep_reason = pr.reason;
       res.error_estimate = pr.error_estimate();

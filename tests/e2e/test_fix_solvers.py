@@ -50,6 +50,7 @@ SOLVERS = {
     "pgs": "solver pgs sweeps 5000 sweep_tol 1e-10",
     "nncg": "solver nncg sweeps 5000 sweep_tol 1e-10",
     "fbgs": "solver fbgs sweeps 5000 sweep_tol 1e-10",
+    "apgd": "solver apgd sweeps 5000 sweep_tol 1e-10",
     "sweep_cg": "sweep_cg yes sweeps 5000 sweep_tol 1e-10",
 }
 

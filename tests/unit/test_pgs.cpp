@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <limits>
 
+#include "fibre/apgd.hpp"
 #include "fibre/nonsmooth_reference.hpp"
 #include "fibre/pgs.hpp"
 #include "fibre/scenes.hpp"
@@ -257,4 +258,32 @@ TEST(FibreBlocks, ConvergeToTheReferenceOnAPile)
     EXPECT_LT(complementarity(pr.sys, serial_exchange(), cones, pr.b, lambda, scale), 1e-9);
     EXPECT_LT(step_accuracy(pr.sys, lambda, ref.lambda).velocity(), 1e-6) << to_string(weight);
   }
+}
+
+// APGD has the sweeps' fixed point (the cones' projection at any step length keeps it), so it
+// converges to the same reference; capped, it says so and keeps its best iterate.
+TEST(Apgd, ConvergesToTheReferenceOnAPile)
+{
+  Problem pr = pile(200, 0.4);
+  const Cones cones(pr.sys);
+  const std::vector<Vec6> scale = row_scales(pr.sys);
+  const Reference ref = nonsmooth_reference(pr.sys, Vector::Zero(pr.sys.contact_dofs()));
+  ASSERT_TRUE(ref.confirmed());
+  Vector lambda = Vector::Zero(pr.sys.contact_dofs());
+  const PgsResult res =
+      apgd(pr.sys, serial_exchange(), cones, pr.b, scale, lambda, PgsControl{20000, 1e-8});
+  EXPECT_TRUE(res.converged());
+  EXPECT_LT(complementarity(pr.sys, serial_exchange(), cones, pr.b, lambda, scale), 1e-8);
+  EXPECT_LT(step_accuracy(pr.sys, lambda, ref.lambda).velocity(), 1e-5);
+  std::printf("apgd: %d iterations, velocity error %.3g\n", res.sweeps,
+              step_accuracy(pr.sys, lambda, ref.lambda).velocity());
+
+  lambda.setZero();
+  const PgsResult capped =
+      apgd(pr.sys, serial_exchange(), cones, pr.b, scale, lambda, PgsControl{5, 1e-11});
+  EXPECT_EQ(capped.reason, StopReason::max_iterations);
+  EXPECT_EQ(capped.sweeps, 5);
+  EXPECT_NEAR(capped.last_change,
+              complementarity(pr.sys, serial_exchange(), cones, pr.b, lambda, scale), 1e-12);
+  EXPECT_TRUE(lambda.allFinite());
 }
