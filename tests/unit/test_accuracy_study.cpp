@@ -60,13 +60,18 @@ TEST(AccuracyStudy, ExportedStepReplaysAndHasAConfirmedReference)
 }
 
 // The sweeps' error estimate (f_ID[16]) against the true error of the normal impulses, for the
-// default and for projected Gauss-Seidel cut at several counts: within a factor of 3.
+// default, for projected Gauss-Seidel cut at several counts, and for the fibre-block sweeps and
+// APGD (whose estimate comes from its residual's contraction): within a factor of 3.
 TEST(AccuracyStudy, ErrorEstimateTracksTheTrueError)
 {
   const StepState st = read_step_state(kState);
   const Reference ref = nonsmooth_reference(st.sys, st.lambda);
   std::vector<StepOptions> settings = {StepOptions{}};
   for (int sweeps : {20, 50, 200, 500}) settings.push_back(sweeps_only(Method::pgs, sweeps));
+  for (int sweeps : {50, 200}) {
+    settings.push_back(sweeps_only(Method::fbgs, sweeps));
+    settings.push_back(sweeps_only(Method::apgd, sweeps));
+  }
   for (const StepOptions &o : settings) {
     const StudyRow row = measure_setting(st, o, ref.lambda, 1.0, 1);
     SCOPED_TRACE(describe(o));
