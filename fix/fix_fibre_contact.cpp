@@ -52,10 +52,10 @@ FixFibreContact::FixFibreContact(LAMMPS *lmp, int narg, char **arg) : Fix(lmp, n
 {
   if (!atom->radius_flag || !atom->rmass_flag || !atom->omega_flag || !atom->torque_flag)
     fail(error, FLERR,
-         std::string("Fix fibre_contact requires atom attributes radius, rmass, "
-                     "omega and torque (use atom_style sphere)"));
+         "Fix fibre_contact requires atom attributes radius, rmass, "
+         "omega and torque (use atom_style sphere)");
   if (domain->dimension != 3)
-    fail(error, FLERR, std::string("Fix fibre_contact requires a 3d simulation (dimension 3)"));
+    fail(error, FLERR, "Fix fibre_contact requires a 3d simulation (dimension 3)");
 
   time_integrate = 1;
   vector_flag = 1;
@@ -211,9 +211,9 @@ void FixFibreContact::check_pair_style(bool at_init)
 {
   if (!force->pair)
     fail(error, FLERR,
-         std::string("Fix fibre_contact requires a granular pair style for its "
-                     "neighbor list, e.g. 'pair_style gran/hooke 1.0 NULL 0.0 NULL "
-                     "0.0 0' and 'pair_coeff * *'"));
+         "Fix fibre_contact requires a granular pair style for its "
+         "neighbor list, e.g. 'pair_style gran/hooke 1.0 NULL 0.0 NULL "
+         "0.0 0' and 'pair_coeff * *'");
   const std::string style = force->pair_style ? force->pair_style : "";
   if (!starts_with(style.c_str(), "gran"))
     fail(error, FLERR,
@@ -223,10 +223,10 @@ void FixFibreContact::check_pair_style(bool at_init)
              style + "'");
   if (at_init && force->pair->compute_flag)
     fail(error, FLERR,
-         std::string("Fix fibre_contact computes every contact force itself, but the "
-                     "pair style's force computation is on: define the pair style "
-                     "before fix fibre_contact and do not use 'pair_modify compute "
-                     "yes'"));
+         "Fix fibre_contact computes every contact force itself, but the "
+         "pair style's force computation is on: define the pair style "
+         "before fix fibre_contact and do not use 'pair_modify compute "
+         "yes'");
 }
 
 // The friction and restitution coefficients per type pair from the pair style (coefficients
@@ -258,10 +258,10 @@ void FixFibreContact::read_coefficients()
       frictionless = frictionless && reading.table.at(i, j).mu == 0.0;
   if (frictionless)
     warn(error, FLERR,
-         std::string("Fix fibre_contact: the pair style's friction coefficient "
-                     "is 0 for every type pair, so every contact is "
-                     "frictionless (give the fix's mu keyword, or "
-                     "'coefficients fix', to set it)"));
+         "Fix fibre_contact: the pair style's friction coefficient "
+         "is 0 for every type pair, so every contact is "
+         "frictionless (give the fix's mu keyword, or "
+         "'coefficients fix', to set it)");
   std::string text = "fix fibre_contact: coefficients from pair style " +
                      std::string(force->pair_style) + " (types i j; walls take i i";
   const fibre::TypedCoefficients &t = model.typed;
@@ -314,7 +314,7 @@ void FixFibreContact::warn_double_integration()
 void FixFibreContact::init()
 {
   if (starts_with(update->integrate_style, "respa"))
-    fail(error, FLERR, std::string("Fix fibre_contact does not support run_style respa"));
+    fail(error, FLERR, "Fix fibre_contact does not support run_style respa");
   check_pair_style(true);
   dtv_ = update->dt;
   detection_->init_walls(settings_.walls);
@@ -332,7 +332,7 @@ void FixFibreContact::setup(int vflag)
   first_step_ = true;
   detection_->start_moving_walls();
   if (!force->pair || !force->pair->list)
-    fail(error, FLERR, std::string("Fix fibre_contact found no neighbor list of the pair style"));
+    fail(error, FLERR, "Fix fibre_contact found no neighbor list of the pair style");
   dtv_ = update->dt;
 }
 

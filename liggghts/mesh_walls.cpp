@@ -26,9 +26,10 @@ namespace fibre_lmp {
 struct LammpsDetection::HostWalls {
   std::vector<FixMeshSurface *> meshes; // per wall, or nullptr
   std::vector<bool> described;          // per wall: its triangles and open edges logged
-  mutable std::vector<fibre::Triangle> triangles;
-  mutable fibre::TriangleGrid grid;
-  mutable std::vector<fibre::TriangleHit> hits;
+  std::vector<fibre::Triangle> triangles;
+  fibre::TriangleGrid grid;
+  std::vector<fibre::TriangleHit> hits;
+  fibre::MeshScratch scratch;
 };
 
 // Constructed and destroyed where HostWalls is complete.
@@ -150,7 +151,7 @@ void LammpsDetection::host_wall_contacts(int w, const std::vector<fibre::Body> &
     const fibre::Body &b = bodies[k];
     const double reach = fibre::region_cutoff(b, h, damping, neighbor->skin, speed);
     host.hits.clear();
-    fibre::mesh_hits(host.triangles, host.grid, b.x, reach, host.hits);
+    fibre::mesh_hits(host.triangles, host.grid, b.x, reach, host.hits, host.scratch);
     for (const fibre::TriangleHit &hit : host.hits) {
       const std::size_t before = found.size();
       add_wall_contact(bodies, k, hit.normal, hit.distance, w, 0, hit.velocity, fibre::Vec3::Zero(),

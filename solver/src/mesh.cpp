@@ -246,9 +246,18 @@ void TriangleGrid::candidates(const Vec3 &x, double reach, std::vector<int> &out
 int mesh_hits(const std::vector<Triangle> &tris, const TriangleGrid &grid, const Vec3 &x,
               double reach, std::vector<TriangleHit> &hits)
 {
-  std::vector<int> candidates;
+  MeshScratch scratch;
+  return mesh_hits(tris, grid, x, reach, hits, scratch);
+}
+
+int mesh_hits(const std::vector<Triangle> &tris, const TriangleGrid &grid, const Vec3 &x,
+              double reach, std::vector<TriangleHit> &hits, MeshScratch &scratch)
+{
+  std::vector<int> &candidates = scratch.candidates;
+  candidates.clear();
   grid.candidates(x, reach, candidates);
-  std::vector<TriangleHit> found;
+  std::vector<TriangleHit> &found = scratch.found;
+  found.clear();
   for (int t : candidates) {
     if (t >= static_cast<int>(tris.size())) continue; // grid built on another array
     const Triangle &tri = tris[t];

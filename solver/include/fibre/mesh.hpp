@@ -76,6 +76,13 @@ class TriangleGrid {
 // hits are sorted by triangle id. Returns how many were appended.
 int mesh_hits(const std::vector<Triangle> &tris, const TriangleGrid &grid, const Vec3 &x,
               double reach, std::vector<TriangleHit> &hits);
+// The same with the caller's working storage, reused from call to call (the per-sphere loop).
+struct MeshScratch {
+  std::vector<int> candidates;
+  std::vector<TriangleHit> found;
+};
+int mesh_hits(const std::vector<Triangle> &tris, const TriangleGrid &grid, const Vec3 &x,
+              double reach, std::vector<TriangleHit> &hits, MeshScratch &scratch);
 
 // Edges used by one triangle only: a mesh's rims and holes, where grains can leave (a closed
 // surface has none). Nodes are matched by rounding their coordinates to multiples of tol; an
