@@ -81,7 +81,8 @@ def main():
             pts = sorted((r["k_products"], r["velocity"]) for r in rows
                          if r["family"] == fam and r["setting"] != DEFAULT and r["velocity"] > 0)
             if pts:
-                ax.loglog([x for x, _ in pts], [y for _, y in pts], styles[fam], ms=3, label=fam)
+                ax.loglog([x for x, _ in pts], [y for _, y in pts], styles[fam], ms=3, label=fam,
+                          color="C%d" % FAMILIES.index(fam))  # the same colour in every panel
         for r in rows:
             if r["setting"] == DEFAULT:
                 ax.loglog([r["k_products"]], [r["velocity"]], "k*", ms=10, label="defaults")

@@ -13,8 +13,8 @@ namespace fibre {
 // One triangle: node positions p, node velocities v (zero for a static mesh) and the front
 // end's global triangle id, which makes the choice among duplicate hits deterministic.
 struct Triangle {
-  Vec3 p[3];
-  Vec3 v[3];
+  Vec3 p[3] = {Vec3::Zero(), Vec3::Zero(), Vec3::Zero()};
+  Vec3 v[3] = {Vec3::Zero(), Vec3::Zero(), Vec3::Zero()};
   long id = 0;
 };
 
