@@ -19,7 +19,8 @@ LAYERS = {
         "contact_history"],
     2: ["spook", "operators", "fibres", "cones", "assembly", "system_io", "stress"],
     3: ["solver_control", "preconditioner", "preconditioner_family", "krylov", "direct", "pgs",
-        "spectra", "analysis", "combined_preconditioner", "nonsmooth_reference"],
+        "fibre_blocks", "apgd", "spectra", "analysis", "combined_preconditioner",
+        "nonsmooth_reference"],
     4: ["step_solver", "accuracy_study"],
     5: ["settings"],
 }
