@@ -69,6 +69,7 @@ FibreBlocks::FibreBlocks(const ContactSystem &sys, const std::vector<int> &owner
   inv_pivot_.assign(n, Mat::Identity());
   lower_.assign(n, Mat::Zero());
   mask_.assign(6 * n, 0);
+  for (std::vector<Vec6> *v : {&rho_, &x_, &step_, &trial_}) v->assign(n, Vec6::Zero());
   valid_.assign(std::size_t(num_blocks()), 0);
   const Vector &inv_mass = sys.inv_mass();
   Mat g, h;
@@ -149,8 +150,7 @@ int FibreBlocks::correct(const Vector &b, Vector &lambda, Vector &dv)
 {
   const int R = rows_;
   const double *inv_mass = sys_.inv_mass().data(), *sigma = sys_.sigma().data();
-  std::vector<Vec6> rho(contacts_.size()), x(contacts_.size()), step(contacts_.size()),
-      trial(contacts_.size());
+  std::vector<Vec6> &rho = rho_, &x = x_, &step = step_, &trial = trial_;
   int kept = 0;
   for (int blk = 0; blk < num_blocks(); ++blk) {
     const int k0 = start_[blk], k1 = start_[blk + 1];

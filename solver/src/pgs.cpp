@@ -74,6 +74,9 @@ PgsResult pgs(const ContactSystem &sys, const Exchange &ex, const Cones &cones, 
   const int nc = sys.num_contacts(), rows = sys.rows();
   std::vector<Vec6> inv_scale(scale.size());
   for (std::size_t c = 0; c < scale.size(); ++c) inv_scale[c] = scale[c].cwiseInverse();
+  // the blocks read their bound rows from feasible impulses
+  if (control.fibre_blocks)
+    for (int c = 0; c < nc; ++c) cones.project(lambda.data() + Eigen::Index(rows) * c, c);
   Vector dv = velocity_change(sys, ex, lambda);
   Vector dv_start, moved, lambda_start; // reused by every sweep
   double best = INFINITY;
@@ -83,8 +86,6 @@ PgsResult pgs(const ContactSystem &sys, const Exchange &ex, const Cones &cones, 
   std::vector<double> changes; // relative change per sweep
   std::unique_ptr<FibreBlocks> blocks;
   if (control.fibre_blocks) {
-    for (int c = 0; c < nc; ++c) cones.project(lambda.data() + Eigen::Index(rows) * c, c);
-    dv = velocity_change(sys, ex, lambda);
     Vector normal(nc);
     for (int c = 0; c < nc; ++c) normal[c] = lambda[Eigen::Index(rows) * c];
     blocks =

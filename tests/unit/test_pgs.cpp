@@ -239,14 +239,27 @@ TEST(FibreBlocks, SolveAColumnInAFewSweeps)
               step_accuracy(sys, block, ref.lambda).velocity());
 }
 
+namespace {
+
+// The 200-sphere pile with its cones, row scales and converged reference.
+struct PileCase {
+  Problem pr = pile(200, 0.4);
+  Cones cones{pr.sys};
+  std::vector<Vec6> scale = row_scales(pr.sys);
+  Reference ref = nonsmooth_reference(pr.sys, Vector::Zero(pr.sys.contact_dofs()));
+};
+
+} // namespace
+
 // On a pile with sliding and released contacts the corrections change the path, not the fixed
 // point: the same impulses as the reference.
 TEST(FibreBlocks, ConvergeToTheReferenceOnAPile)
 {
-  Problem pr = pile(200, 0.4);
-  const Cones cones(pr.sys);
-  const std::vector<Vec6> scale = row_scales(pr.sys);
-  const Reference ref = nonsmooth_reference(pr.sys, Vector::Zero(pr.sys.contact_dofs()));
+  const PileCase pc;
+  const Problem &pr = pc.pr;
+  const Cones &cones = pc.cones;
+  const std::vector<Vec6> &scale = pc.scale;
+  const Reference &ref = pc.ref;
   ASSERT_TRUE(ref.confirmed());
   for (EdgeWeight weight : {EdgeWeight::z, EdgeWeight::impulse}) {
     PgsControl control{100000, 1e-12, 100000};
@@ -264,10 +277,11 @@ TEST(FibreBlocks, ConvergeToTheReferenceOnAPile)
 // converges to the same reference; capped, it says so and keeps its best iterate.
 TEST(Apgd, ConvergesToTheReferenceOnAPile)
 {
-  Problem pr = pile(200, 0.4);
-  const Cones cones(pr.sys);
-  const std::vector<Vec6> scale = row_scales(pr.sys);
-  const Reference ref = nonsmooth_reference(pr.sys, Vector::Zero(pr.sys.contact_dofs()));
+  const PileCase pc;
+  const Problem &pr = pc.pr;
+  const Cones &cones = pc.cones;
+  const std::vector<Vec6> &scale = pc.scale;
+  const Reference &ref = pc.ref;
   ASSERT_TRUE(ref.confirmed());
   Vector lambda = Vector::Zero(pr.sys.contact_dofs());
   const PgsResult res =

@@ -48,6 +48,7 @@ class FibreBlocks {
   std::vector<Mat> lower_;           // and L_k = A_k,k-1 S_k-1^-1
   std::vector<unsigned char> mask_;  // 6 per block contact: 1 = row free in the factor
   std::vector<unsigned char> valid_; // per block: its factor matches mask_
+  std::vector<Vec6> rho_, x_, step_, trial_; // correct()'s working storage, per block contact
 };
 
 } // namespace fibre
