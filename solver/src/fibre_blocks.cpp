@@ -4,18 +4,9 @@
 #include <cmath>
 
 #include "fibre/contact_rows.hpp"
+#include "fibre/kernels.hpp"
 
 namespace fibre {
-
-namespace {
-
-// The body two consecutive block contacts share (they are neighbours in a chain).
-int shared_body(int pa, int pb, int qa, int qb)
-{
-  return pa == qa || pa == qb ? pa : pb;
-}
-
-} // namespace
 
 FibreBlocks::FibreBlocks(const ContactSystem &sys, const std::vector<int> &owners,
                          const Cones &cones, EdgeWeight weight, const Vector *impulses)
@@ -71,47 +62,12 @@ FibreBlocks::FibreBlocks(const ContactSystem &sys, const std::vector<int> &owner
   mask_.assign(6 * n, 0);
   for (std::vector<Vec6> *v : {&rho_, &x_, &step_, &trial_}) v->assign(n, Vec6::Zero());
   valid_.assign(std::size_t(num_blocks()), 0);
-  const Vector &inv_mass = sys.inv_mass();
-  Mat g, h;
+  // A_kk and A_k,k+1 as the contact-form preconditioners form them (kernels.hpp).
   for (int blk = 0; blk < num_blocks(); ++blk)
     for (int k = start_[blk]; k < start_[blk + 1]; ++k) {
-      const int c = contacts_[k];
-      const Contact &ck = sys.contacts()[c];
-      Mat &d = diag_[k];
-      d.setZero();
-      for (int body : {body_of(ck.a), body_of(ck.b)}) {
-        if (body < 0) continue;
-        body_rows(c, body, g);
-        d += g * inv_mass.segment<6>(6 * Eigen::Index(body)).asDiagonal() * g.transpose();
-      }
-      for (int i = 0; i < 6; ++i)
-        d(i, i) += i < rows_ ? sys.sigma()[rows_ * Eigen::Index(c) + i] : 1.0;
-      if (k + 1 == start_[blk + 1]) continue;
-      const Contact &cn = sys.contacts()[contacts_[k + 1]];
-      const int s = shared_body(body_of(ck.a), body_of(ck.b), body_of(cn.a), body_of(cn.b));
-      body_rows(c, s, g);
-      body_rows(contacts_[k + 1], s, h);
-      upper_[k] = g * inv_mass.segment<6>(6 * Eigen::Index(s)).asDiagonal() * h.transpose();
+      diag_[k] = diagonal_block(sys, contacts_[k]);
+      if (k + 1 < start_[blk + 1]) upper_[k] = coupling_block(sys, contacts_[k], contacts_[k + 1]);
     }
-}
-
-// G's rows of contact c on `body` (signed: minus for the contact's second body), padded with
-// zero rows beyond sys.rows().
-void FibreBlocks::body_rows(int c, int body, Mat &g) const
-{
-  g.setZero();
-  const ContactKinematics &q = sys_.kinematics(c);
-  const bool side_a = body_of(sys_.contacts()[c].a) == body;
-  const double zero[6] = {0, 0, 0, 0, 0, 0};
-  for (int j = 0; j < 6; ++j) {
-    double e[6] = {0, 0, 0, 0, 0, 0}, u[6];
-    e[j] = 1.0;
-    if (side_a)
-      contact_velocity<6>(q.frame.data(), q.ra.data(), q.rb.data(), e, nullptr, u);
-    else
-      contact_velocity<6>(q.frame.data(), q.ra.data(), q.rb.data(), zero, e, u);
-    for (int i = 0; i < rows_; ++i) g(i, j) = u[i];
-  }
 }
 
 // Block LDL^T of the masked block (masked rows and columns replaced by the identity):

@@ -34,7 +34,6 @@ class FibreBlocks {
  private:
   using Mat = Mat6; // rows beyond sys.rows() are padded as decoupled identity rows
   void factor(int blk);
-  void body_rows(int c, int body, Mat &g) const; // G's block of contact c on `body`
   int body_of(int index) const { return owners_.empty() || index < 0 ? index : owners_[index]; }
 
   const ContactSystem &sys_;
