@@ -33,7 +33,8 @@ with K = M + G^T Sigma^-1 G, timed in the same run).
 
 options:
   --setting "KEYWORDS"  fix fibre_contact solver keywords (form, solver, precond, weight, tol,
-                        pass_tol, maxiter, active_set, sweeps, sweep_tol), repeatable; the
+                        linear_tol, pass_tol, maxiter, active_set, sweeps, sweep_tol),
+                        repeatable; the
                         empty string is the defaults. Without --setting: a standard grid.
   --repeat N            time each setting N times, keep the fastest (default 3)
   --target X            complementarity residual of the reference (default 1e-10)
@@ -51,7 +52,7 @@ const std::vector<std::string> kGrid = {
     "sweeps 200 sweep_tol 1e-4",
     "sweeps 1000 sweep_tol 1e-6",
     "active_set 10 sweeps 0",
-    "tol 1e-8 active_set 10 sweeps 200 sweep_tol 1e-4",
+    "linear_tol 1e-8 active_set 10 sweeps 200 sweep_tol 1e-4",
     "solver pgs sweeps 50 sweep_tol 1e-12",
     "solver pgs sweeps 200 sweep_tol 1e-12",
     "solver pgs sweeps 500 sweep_tol 1e-12",

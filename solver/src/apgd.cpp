@@ -62,7 +62,12 @@ PgsResult apgd(const ContactSystem &sys, const Exchange &ex, const Cones &cones,
   // In the scaled variables the diagonal of D^-1 A is about 1: L starts there and adapts.
   double L = 1.0, theta = 1.0;
   std::vector<double> history; // residual per iteration
-  for (int it = 0; it < control.max_sweeps && best_residual > control.tol; ++it) {
+  // the residual rule on the best iterate, which is what is returned
+  const auto done = [&] {
+    return control.accuracy > 0 ? res.error_estimate() <= control.accuracy
+                                : best_residual <= control.tol;
+  };
+  for (int it = 0; it < control.max_sweeps && !done(); ++it) {
     const Vector gy = Ay - b;
     const double fy = pr.energy(y, Ay);
     Vector xn, Axn;
@@ -109,7 +114,7 @@ PgsResult apgd(const ContactSystem &sys, const Exchange &ex, const Cones &cones,
   lambda = best;
   res.last_change = best_residual;
   if (res.reason != StopReason::non_finite)
-    res.reason = best_residual <= control.tol ? StopReason::converged : StopReason::max_iterations;
+    res.reason = done() ? StopReason::converged : StopReason::max_iterations;
   return res;
 }
 

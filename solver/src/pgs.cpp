@@ -120,7 +120,9 @@ PgsResult pgs(const ContactSystem &sys, const Exchange &ex, const Cones &cones, 
       res.contraction = first > 0 ? std::pow(res.last_change / first, 1.0 / kRateWindow) : 1.0;
     }
     res.reason = StopReason::max_iterations;
-    if (!(norms[0] > control.tol * control.tol * norms[1])) {
+    const bool done = control.accuracy > 0 ? res.error_estimate() <= control.accuracy
+                                           : !(norms[0] > control.tol * control.tol * norms[1]);
+    if (done) {
       res.reason = StopReason::converged;
       break;
     }

@@ -116,7 +116,8 @@ std::size_t read_wall(const Reader &in, std::size_t i, WallSpec &w)
 }
 
 // The solver keywords; returns the words read, 0 when `key` is not one of them.
-std::size_t read_solver_keyword(const Reader &in, std::size_t i, StepOptions &opt)
+std::size_t read_solver_keyword(const Reader &in, std::size_t i, StepOptions &opt,
+                                bool &sweeps_typed)
 {
   const std::string &key = in.at(i);
   if (key == "form")
@@ -127,8 +128,11 @@ std::size_t read_solver_keyword(const Reader &in, std::size_t i, StepOptions &op
     opt.precond.kind = in.name<PrecondKind>(i + 1, key);
   else if (key == "weight")
     opt.precond.weight = in.name<EdgeWeight>(i + 1, key);
-  else if (key == "tol")
-    opt.stop.tol = in.positive(i + 1, "'tol <positive number>'");
+  else if (key == "tol") {
+    const std::string e = "'tol none|<positive number>'";
+    opt.accuracy = in.has(i + 1) && in.at(i + 1) == "none" ? 0.0 : in.positive(i + 1, e);
+  } else if (key == "linear_tol")
+    opt.stop.tol = in.positive(i + 1, "'linear_tol <positive number>'");
   else if (key == "pass_tol")
     opt.pass_tol = in.positive(i + 1, "'pass_tol <positive number>'");
   else if (key == "maxiter")
@@ -137,9 +141,10 @@ std::size_t read_solver_keyword(const Reader &in, std::size_t i, StepOptions &op
   else if (key == "active_set")
     opt.active_set_max =
         static_cast<int>(in.integer(i + 1, "'active_set <positive integer>'", 1, 1000));
-  else if (key == "sweeps")
+  else if (key == "sweeps") {
     opt.sweeps = static_cast<int>(in.integer(i + 1, "'sweeps <non-negative integer>'", 0, 100000));
-  else if (key == "sweep_tol")
+    sweeps_typed = true;
+  } else if (key == "sweep_tol")
     opt.sweep_tol = in.positive(i + 1, "'sweep_tol <positive number>'");
   else if (key == "rescue_sweeps")
     opt.rescue_sweeps =
@@ -246,9 +251,10 @@ Settings parse_settings(const std::vector<std::string> &args)
   Settings s;
   const Reader in(args);
   std::size_t i = 0;
+  bool sweeps_typed = false;
   while (i < args.size()) {
     const std::string &key = args[i];
-    std::size_t used = read_solver_keyword(in, i, s.step);
+    std::size_t used = read_solver_keyword(in, i, s.step, sweeps_typed);
     if (!used) used = read_model_keyword(in, i, s);
     if (!used && key == "wall") {
       WallSpec w;
@@ -263,14 +269,17 @@ Settings parse_settings(const std::vector<std::string> &args)
       used = 3;
     }
     if (!used)
-      Reader::illegal("a keyword (form, solver, precond, weight, tol, pass_tol, maxiter, "
-                      "compliance, damping, mu, mu_roll, mu_twist, rows, active_set, sweeps, "
-                      "sweep_tol, rescue_sweeps, sweep_cg, sweep_blocks, recovery_speed, "
-                      "restitution, bounce_speed, "
-                      "coefficients, wall, export)",
-                      &key);
+      Reader::illegal(
+          "a keyword (form, solver, precond, weight, tol, linear_tol, pass_tol, maxiter, "
+          "compliance, damping, mu, mu_roll, mu_twist, rows, active_set, sweeps, "
+          "sweep_tol, rescue_sweeps, sweep_cg, sweep_blocks, recovery_speed, "
+          "restitution, bounce_speed, "
+          "coefficients, wall, export)",
+          &key);
     i += used;
   }
+  // a step accuracy needs room to reach it
+  if (s.step.accuracy > 0 && !sweeps_typed) s.step.sweeps = kAccuracySweeps;
   const FrictionParams &f = s.model.friction;
   if (s.model.rows == 3 && (f.mu_roll > 0.0 || f.mu_twist > 0.0))
     throw SettingsError("mu_roll and mu_twist need 'rows 6' (rows 3 has no rotational rows)");

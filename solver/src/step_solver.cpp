@@ -18,7 +18,8 @@ std::string describe(const StepOptions &opt)
   const auto g = format_g;
   return std::string("form ") + to_string(opt.form) + ", solver " + to_string(opt.solver) +
          ", precond " + to_string(opt.precond.kind) + ", weight " + to_string(opt.precond.weight) +
-         ", tol " + g(opt.stop.tol) + ", pass_tol " + g(opt.pass_tol) + ", maxiter " +
+         ", tol " + (opt.accuracy > 0 ? g(opt.accuracy) : std::string("none")) + ", linear_tol " +
+         g(opt.stop.tol) + ", pass_tol " + g(opt.pass_tol) + ", maxiter " +
          std::to_string(opt.stop.max_iter) + ", active_set " + std::to_string(opt.active_set_max) +
          ", sweeps " + std::to_string(opt.sweeps) + ", sweep_tol " + g(opt.sweep_tol) +
          ", rescue_sweeps " + std::to_string(opt.rescue_sweeps) +
@@ -276,8 +277,10 @@ void StepSolver::finish(Vector &lambda, StepResult &res) const
   res.sweeps = 0;
   res.complementarity = complementarity(sys_, ex_, cones_, b_full_, lambda, scale);
   res.error_estimate = res.complementarity;
-  if (opt_.sweeps > 0 && res.complementarity > opt_.sweep_tol) {
+  const bool accuracy = opt_.accuracy > 0;
+  if (opt_.sweeps > 0 && (accuracy || res.complementarity > opt_.sweep_tol)) {
     PgsControl control{opt_.sweeps, opt_.sweep_tol};
+    control.accuracy = opt_.accuracy;
     control.nonlinear_cg = opt_.sweep_cg || opt_.solver == Method::nncg;
     control.fibre_blocks = opt_.sweep_blocks || opt_.solver == Method::fbgs;
     control.block_weight = opt_.precond.weight;
@@ -293,7 +296,7 @@ void StepSolver::finish(Vector &lambda, StepResult &res) const
     sweep();
     // far from sweep_tol at the cap: sweep on (collective: every process sees the residual);
     // with a sweeps-only solver the sweeps are the whole solve the user asked for
-    if (!sweeps_only() && res.sweep_reason == StopReason::max_iterations &&
+    if (!sweeps_only() && !accuracy && res.sweep_reason == StopReason::max_iterations &&
         opt_.rescue_sweeps > res.sweeps && res.complementarity > kRescueFactor * opt_.sweep_tol) {
       control.max_sweeps = opt_.rescue_sweeps - res.sweeps;
       res.rescued = true;
@@ -426,13 +429,18 @@ StepResult StepSolver::run(const Vector *warm)
       res.restarted = true;
     }
   }
-  if (!sweeps_only() && res.converged && opt_.sweeps > 0 &&
-      res.complementarity > kRescueFactor * opt_.sweep_tol) {
+  if (opt_.accuracy > 0) {
+    if (res.converged && !(res.error_estimate <= opt_.accuracy)) {
+      res.converged = false;
+      res.reason =
+          res.sweep_reason == StopReason::converged ? StopReason::stagnation : res.sweep_reason;
+    }
+  } else if (!sweeps_only() && res.converged && opt_.sweeps > 0 &&
+             res.complementarity > kRescueFactor * opt_.sweep_tol) {
     res.converged = false;
     res.reason =
         res.sweep_reason == StopReason::converged ? StopReason::stagnation : res.sweep_reason;
-  }
-  if (sweeps_only() && res.complementarity > opt_.sweep_tol) {
+  } else if (sweeps_only() && res.complementarity > opt_.sweep_tol) {
     res.converged = false;
     // sweeps that stopped moving above the tolerance stagnated
     res.reason =

@@ -51,9 +51,10 @@ CASES = [
     ("precond_invalid", "precond ilu", "expected 'precond none|jacobi|block|fibre|tree', got "
      "'ilu'", {}),
     ("weight_invalid", "weight mass", "expected 'weight z|straight|impulse', got 'mass'", {}),
-    ("tol_negative", "tol -1e-6", "expected 'tol <positive number>', got '-1e-6'", {}),
-    ("tol_text", "tol small", "expected 'tol <positive number>', got 'small'", {}),
-    ("tol_missing", "mu 0.3 tol", "expected 'tol <positive number>'", {}),
+    ("tol_negative", "tol -1e-6", "expected 'tol none|<positive number>', got '-1e-6'", {}),
+    ("tol_text", "tol small", "expected 'tol none|<positive number>', got 'small'", {}),
+    ("tol_missing", "mu 0.3 tol", "expected 'tol none|<positive number>'", {}),
+    ("linear_tol_zero", "linear_tol 0", "expected 'linear_tol <positive number>', got '0'", {}),
     ("pass_tol_zero", "pass_tol 0", "expected 'pass_tol <positive number>'", {}),
     ("pass_tol_missing", "pass_tol", "expected 'pass_tol <positive number>'", {}),
     ("sweeps_negative", "sweeps -1", "expected 'sweeps <non-negative integer>', got '-1'", {}),

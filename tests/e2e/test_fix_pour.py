@@ -22,7 +22,7 @@ within 1% and the number of contacts within 10% (granular flow amplifies the dif
 so trajectories diverge later). The parallel front end alone (ownership of contacts, halo
 exchange) is exact: without friction, in the contact form with the block preconditioner
 (which, unlike the trees, does not depend on how the contacts are split between processes)
-every pass solved to tol 1e-6 (a loose pass can stop one iteration apart on different
+every pass solved to linear_tol 1e-6 (a loose pass can stop one iteration apart on different
 process counts) and no Gauss-Seidel sweeps (each process sweeps its own contacts in turn, so
 the sweeps differ by sweep_tol between process counts, not by round-off), the same scene agrees with the serial run to 1e-9 for 300 steps on 2 and 4
 processes. The parallel runs stop at step MPI_STEPS = 400
@@ -162,7 +162,7 @@ def main():
     ref = None
     for np in (1, 2, 4):
         tag = "frictionless np%d" % np
-        run = e2e.run_lmp(args, FIBRE.format(dt=DT, steps=300, opts="mu 0 form contact solver cr precond block tol 1e-6 pass_tol 1e-6 active_set 5 sweeps 0"),
+        run = e2e.run_lmp(args, FIBRE.format(dt=DT, steps=300, opts="mu 0 form contact solver cr precond block linear_tol 1e-6 pass_tol 1e-6 active_set 5 sweeps 0"),
                           "pour_mu0_np%d" % np, np=np, timeout=600)
         if not ck.ran(run, "%s: 300 steps" % tag) or not run.thermo:
             continue

@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include "fibre/accuracy_study.hpp"
+#include "fibre/settings.hpp"
 #include "fibre/system_io.hpp"
 #include "reference.hpp"
 
@@ -79,6 +80,40 @@ TEST(AccuracyStudy, ErrorEstimateTracksTheTrueError)
     EXPECT_LT(row.error_estimate, 3.0 * row.error.lambda_n);
     EXPECT_GT(row.error_estimate, row.error.lambda_n / 3.0);
   }
+}
+
+// tol is the step's accuracy: the sweeps go on until their error estimate is within it. For the
+// default solver and the Gauss-Seidel ones the step's true errors against the reference follow
+// tol down: the normal impulses within 1.5 tol (measured 0.8 to 1.05 tol), the velocity change
+// within 3 tol (its rotational part, 2.1 tol), every impulse group within 10 tol (rolling,
+// 5.8 to 7 tol); each costs more sweeps than a looser tol. (The estimate of nncg and apgd runs
+// 5 to 8x optimistic at 1e-3, the doc page says so.)
+TEST(AccuracyStudy, TolIsTheStepsAccuracy)
+{
+  const StepState st = read_step_state(kState);
+  const Reference ref = nonsmooth_reference(st.sys, st.lambda);
+  for (const char *solver : {"cg", "pgs", "fbgs"}) {
+    int last_sweeps = 0;
+    for (double tol : {1e-2, 1e-3, 1e-4}) {
+      const StepOptions o = parse_settings({"solver", solver, "tol", std::to_string(tol)}).step;
+      const StudyRow row = measure_setting(st, o, ref.lambda, 1.0, 1);
+      SCOPED_TRACE(describe(o));
+      EXPECT_TRUE(row.converged);
+      EXPECT_LE(row.error_estimate, tol);
+      EXPECT_LT(row.error.lambda_n, 1.5 * tol);
+      EXPECT_LT(row.error.velocity(), 3 * tol);
+      EXPECT_LT(row.error.impulse(), 10 * tol);
+      EXPECT_GT(row.sweeps, last_sweeps);
+      last_sweeps = row.sweeps;
+    }
+  }
+  // the defaults (tol none) miss 1e-3 on this state; tol 1e-3 meets it in velocity
+  const StudyRow def = measure_setting(st, StepOptions{}, ref.lambda, 1.0, 1);
+  const StudyRow tight =
+      measure_setting(st, parse_settings({"tol", "1e-3"}).step, ref.lambda, 1.0, 1);
+  EXPECT_GT(def.error.velocity(), 1e-3);
+  EXPECT_LT(tight.error.velocity(), 1e-3);
+  EXPECT_LT(tight.error.impulse(), 1e-2);
 }
 
 TEST(AccuracyStudy, BadStateFilesAreNamed)

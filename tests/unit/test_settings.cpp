@@ -48,6 +48,7 @@ TEST(Settings, NoKeywordsKeepTheDefaults)
   EXPECT_EQ(d.active_set_max, 1);
   EXPECT_EQ(d.sweeps, 50);
   EXPECT_DOUBLE_EQ(d.sweep_tol, 1e-3);
+  EXPECT_DOUBLE_EQ(d.accuracy, 0.0); // tol none
   EXPECT_DOUBLE_EQ(s.model.friction.mu, 0.5);
   EXPECT_EQ(s.model.rows, 6);
   EXPECT_DOUBLE_EQ(s.model.damping, 2.0);
@@ -56,8 +57,9 @@ TEST(Settings, NoKeywordsKeepTheDefaults)
   EXPECT_TRUE(s.walls.empty());
   EXPECT_EQ(s.export_every, 0);
   EXPECT_EQ(describe(s),
-            "form body, solver cg, precond tree, weight z, tol 0.0001, pass_tol 0.001, maxiter "
-            "200, active_set 1, sweeps 50, sweep_tol 0.001, rescue_sweeps 500, rows 6, damping 2, "
+            "form body, solver cg, precond tree, weight z, tol none, linear_tol 0.0001, pass_tol "
+            "0.001, maxiter 200, active_set 1, sweeps 50, sweep_tol 0.001, rescue_sweeps 500, rows "
+            "6, damping 2, "
             "compliance auto "
             "(0.01 dt^2 / m_min), recovery_speed auto (0.01 r_min / dt), restitution 0, "
             "bounce_speed auto (2 dt |f| / m max, or 0.01 r_min / dt without forces), coefficients "
@@ -68,8 +70,9 @@ TEST(Settings, NoKeywordsKeepTheDefaults)
 TEST(Settings, EveryKeywordSetsWhatItNames)
 {
   const Settings s = parse_settings(
-      words("form contact solver uzawa precond fibre weight impulse tol 1e-6 pass_tol 1e-5 "
-            "maxiter 77 compliance 1e-7 2e-7 damping 3 mu 0.3 mu_roll 0.1 mu_twist 0.05 rows 6 "
+      words("form contact solver uzawa precond fibre weight impulse linear_tol 1e-6 "
+            "pass_tol 1e-5 tol 2e-3 maxiter 77 compliance 1e-7 2e-7 damping 3 mu 0.3 mu_roll 0.1 "
+            "mu_twist 0.05 rows 6 "
             "active_set 4 sweeps 9 sweep_tol 1e-4 wall zplane 0 NULL wall xplane -1 1 "
             "wall region box export 10 out/sys"));
   EXPECT_EQ(s.step.form, Form::contact);
@@ -78,6 +81,7 @@ TEST(Settings, EveryKeywordSetsWhatItNames)
   EXPECT_EQ(s.step.precond.weight, EdgeWeight::impulse);
   EXPECT_DOUBLE_EQ(s.step.stop.tol, 1e-6);
   EXPECT_DOUBLE_EQ(s.step.pass_tol, 1e-5);
+  EXPECT_DOUBLE_EQ(s.step.accuracy, 2e-3);
   EXPECT_EQ(s.step.stop.max_iter, 77);
   EXPECT_FALSE(s.model.compliance.automatic);
   EXPECT_DOUBLE_EQ(s.model.compliance.eps_n, 1e-7);
@@ -141,15 +145,27 @@ TEST(Settings, StrictNumbers)
   EXPECT_FALSE(to_long("99999999999999999999999", n));
 }
 
+// A step accuracy needs room to reach it: the sweeps' cap rises unless typed.
+TEST(Settings, TolIsTheStepAccuracyAndRaisesTheSweepCap)
+{
+  EXPECT_EQ(parse_settings(words("tol 1e-3")).step.sweeps, kAccuracySweeps);
+  EXPECT_DOUBLE_EQ(parse_settings(words("tol 1e-3")).step.accuracy, 1e-3);
+  EXPECT_EQ(parse_settings(words("sweeps 300 tol 1e-3")).step.sweeps, 300);
+  EXPECT_EQ(parse_settings(words("tol 1e-3 sweeps 300")).step.sweeps, 300);
+  EXPECT_EQ(parse_settings(words("tol none")).step.sweeps, StepOptions{}.sweeps);
+  EXPECT_DOUBLE_EQ(parse_settings(words("tol 1e-3 tol none")).step.accuracy, 0.0);
+}
+
 TEST(Settings, BadInputNamesTheKeywordAndItsForm)
 {
   EXPECT_EQ(error_of("form primal"), "expected 'form body|contact', got 'primal'");
   EXPECT_EQ(error_of("solver bicgstab"),
             "expected 'solver cg|cr|minres|direct|pgs|nncg|fbgs|apgd', got 'bicgstab'");
   EXPECT_EQ(error_of("precond"), "expected 'precond none|jacobi|block|fibre|tree'");
-  EXPECT_EQ(error_of("tol -1"), "expected 'tol <positive number>', got '-1'");
-  EXPECT_EQ(error_of("tol 1e-3x"), "expected 'tol <positive number>', got '1e-3x'");
-  EXPECT_EQ(error_of("tol nan"), "expected 'tol <positive number>', got 'nan'");
+  EXPECT_EQ(error_of("tol -1"), "expected 'tol none|<positive number>', got '-1'");
+  EXPECT_EQ(error_of("tol 1e-3x"), "expected 'tol none|<positive number>', got '1e-3x'");
+  EXPECT_EQ(error_of("tol"), "expected 'tol none|<positive number>'");
+  EXPECT_EQ(error_of("linear_tol nan"), "expected 'linear_tol <positive number>', got 'nan'");
   EXPECT_EQ(error_of("maxiter 2.5"), "expected 'maxiter <positive integer>', got '2.5'");
   EXPECT_EQ(error_of("sweeps -1"), "expected 'sweeps <non-negative integer>', got '-1'");
   EXPECT_EQ(error_of("mu -0.1"), "expected 'mu <non-negative number>', got '-0.1'");

@@ -48,7 +48,7 @@ Body sphere(double mass, double radius, const Vec3 &x)
 }
 
 // The settings these tests were written for (the library's defaults before they moved to the
-// measured ones of the fix): MINRES, block preconditioner, tol 1e-6, 5 passes.
+// measured ones of the fix): MINRES, block preconditioner, linear_tol 1e-6, 5 passes.
 StepOptions base_options()
 {
   StepOptions o;

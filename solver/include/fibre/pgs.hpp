@@ -14,8 +14,9 @@
 namespace fibre {
 
 // Stop when a sweep moves lambda by at most tol relative to |lambda| (2-norms over all
-// processes), or after max_sweeps sweeps. Stagnation: no new smallest change for
-// stall_sweeps sweeps in a row.
+// processes), or, with accuracy > 0, when the estimated remaining error of the impulses
+// (PgsResult::error_estimate) is at most accuracy instead; or after max_sweeps sweeps.
+// Stagnation: no new smallest change for stall_sweeps sweeps in a row.
 struct PgsControl {
   int max_sweeps = 50;
   double tol = 1e-3;
@@ -28,6 +29,7 @@ struct PgsControl {
   // block_weight from the starting impulses.
   bool fibre_blocks = false;
   EdgeWeight block_weight = EdgeWeight::impulse;
+  double accuracy = 0; // the error-estimate rule (0: off)
 };
 
 inline constexpr int kRateWindow = 5;

@@ -1,6 +1,6 @@
 // The settings of fix fibre_contact, shared by every front end: its keywords parsed into the
 // step's options, the contact model, the walls and the export, with LAMMPS-style messages
-// ("expected 'tol <positive number>', got '-1'"). Defaults come from StepOptions{} and
+// ("expected 'linear_tol <positive number>', got '-1'"). Defaults come from StepOptions{} and
 // ContactModel{}: a keyword the user did not type leaves them as they are.
 #pragma once
 

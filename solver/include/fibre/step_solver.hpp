@@ -50,9 +50,16 @@ struct StepOptions {
   bool sweep_cg = false;
   // Fibre-block corrections before every sweep (always with solver fbgs).
   bool sweep_blocks = false;
+  // The step's accuracy (keyword tol; 0: none). When set, the sweeps stop only when their
+  // estimate of the impulses' remaining relative error (StepResult::error_estimate) is at most
+  // this, after at most `sweeps` sweeps; sweep_tol and the rescue then play no part, and a step
+  // that ends above it counts as not converged.
+  double accuracy = 0;
 };
 
 inline constexpr double kRescueFactor = 10.0;
+// The sweeps' cap when a step's accuracy is set and `sweeps` was not typed.
+inline constexpr int kAccuracySweeps = 2000;
 
 // The settings as one line, "name value, name value, ..." (PETSc KSPView style): the front
 // ends log it, and the doc page's defaults are this line for StepOptions{}.
@@ -67,7 +74,7 @@ struct StepResult {
   double rel_residual = 0; // of the last linear solve: true ||b - A x|| / ||b|| in its form
   StopReason reason = StopReason::converged; // first failed solve's reason, else converged
   // every linear solve converged, and the step ended within kRescueFactor of sweep_tol (of it
-  // with solver pgs or nncg)
+  // with solver pgs or nncg), or, with a step accuracy, its error estimate within it
   bool converged = true;
   int active_set_passes = 0; // linear solves done (1 .. active_set_max)
   bool set_settled = false;  // the active set and its caps settled (see cap_tol)
