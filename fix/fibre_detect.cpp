@@ -87,6 +87,7 @@ LammpsDetection::contacts(const std::vector<fibre::Body> &bodies, double h, doub
                           bool impacts)
 {
   std::vector<fibre::DetectedContact> found;
+  found.reserve(last_found_ + last_found_ / 8 + 16); // about the last step's, without regrowth
   kick_.clear();
   pair_contacts(bodies, h, damping, found);
   wall_contacts(bodies, h, damping, found);
@@ -114,6 +115,7 @@ LammpsDetection::contacts(const std::vector<fibre::Body> &bodies, double h, doub
     wall_contacts(bodies, h, damping, found);
   }
   fibre::sort_contacts(found);
+  last_found_ = found.size();
   return found;
 }
 
@@ -152,10 +154,12 @@ void LammpsDetection::pair_contacts(const std::vector<fibre::Body> &bodies, doub
       fc.store = low < nlocal ? low : high;
       if (bi >= 0 && bj >= 0) {
         const int a = tag[i] < tag[j] ? bi : bj, b = a == bi ? bj : bi;
-        fc.contact = fibre::sphere_sphere_contact(bodies, a, b);
-        if (!fibre::is_contact(bodies[a], &bodies[b], fc.contact.normal, fc.contact.gap, h, damping,
-                               kick(a) + kick(b)))
+        fibre::Vec3 normal;
+        double gap = 0.0;
+        fibre::sphere_sphere_gap(bodies[a], bodies[b], normal, gap);
+        if (!fibre::is_contact(bodies[a], &bodies[b], normal, gap, h, damping, kick(a) + kick(b)))
           continue;
+        fc.contact = fibre::sphere_sphere_contact(bodies, a, b);
         fc.tag_a = tag[low];
         fc.partner = static_cast<double>(tag[high]);
       } else {

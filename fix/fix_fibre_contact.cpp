@@ -506,6 +506,7 @@ void FixFibreContact::final_integrate()
 
   // build (a step without contacts anywhere is free flight: an empty system and result)
   std::vector<fibre::Contact> contacts;
+  contacts.reserve(found.size());
   for (const fibre::DetectedContact &fc : found) contacts.push_back(fc.contact);
   const fibre::Vector warm = history_.warm_start(found, model.rows, dtv_);
   history_.load_springs(found, contacts);

@@ -41,15 +41,22 @@ void Cones::project(double *l, int c) const
 
 std::vector<Vec6> row_scales(const ContactSystem &sys)
 {
-  const int nc = sys.num_contacts();
+  std::vector<Vec6> diagonal(sys.num_contacts());
+  for (int c = 0; c < sys.num_contacts(); ++c) diagonal[c] = diagonal_entries(sys, c);
+  return row_scales(diagonal, sys.rows());
+}
+
+std::vector<Vec6> row_scales(const std::vector<Vec6> &diagonal, int rows)
+{
+  const int nc = static_cast<int>(diagonal.size());
   std::vector<Vec6> scale(nc, Vec6::Ones());
   for (int c = 0; c < nc; ++c) {
-    const Mat6 D = diagonal_block(sys, c);
-    scale[c][0] = D(0, 0);
-    for (int k = 0; k < num_cones(sys.rows()); ++k) {
+    const Vec6 &D = diagonal[c];
+    scale[c][0] = D[0];
+    for (int k = 0; k < num_cones(rows); ++k) {
       const Cone &cone = kCones[k];
-      double d = D(cone.first, cone.first);
-      if (cone.size == 2) d = std::max(d, D(cone.first + 1, cone.first + 1));
+      double d = D[cone.first];
+      if (cone.size == 2) d = std::max(d, D[cone.first + 1]);
       for (int i = 0; i < cone.size; ++i) scale[c][cone.first + i] = d;
     }
   }

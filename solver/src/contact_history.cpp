@@ -6,23 +6,25 @@ namespace fibre {
 
 void ContactHistory::grow(int nmax)
 {
-  if (nmax <= capacity()) return;
+  const int old = capacity();
+  if (nmax <= old) return;
+  std::unique_ptr<double[]> room(new double[std::size_t(nmax) * kStride]); // not filled
+  for (int i = 0; i < old; ++i)
+    std::copy(slots(i), slots(i) + count_[i] * kSlotSize, room.get() + std::size_t(i) * kStride);
+  slots_ = std::move(room);
   count_.resize(nmax, 0);
-  slots_.resize(std::size_t(nmax) * kMaxSlots * kSlotSize, 0.0);
 }
 
 void ContactHistory::copy(int from, int to)
 {
   count_[to] = count_[from];
-  const double *src = &slots_[std::size_t(from) * kMaxSlots * kSlotSize];
-  std::copy(src, src + count_[from] * kSlotSize, &slots_[std::size_t(to) * kMaxSlots * kSlotSize]);
+  std::copy(slots(from), slots(from) + count_[from] * kSlotSize, slots(to));
 }
 
 int ContactHistory::pack(int i, double *buf) const
 {
   buf[0] = count_[i];
-  const double *src = &slots_[std::size_t(i) * kMaxSlots * kSlotSize];
-  std::copy(src, src + count_[i] * kSlotSize, buf + 1);
+  std::copy(slots(i), slots(i) + count_[i] * kSlotSize, buf + 1);
   return packed_size(i);
 }
 
@@ -32,7 +34,7 @@ int ContactHistory::unpack(int i, const double *buf, int available, int slot_siz
   const int n = std::min(
       {kMaxSlots, std::max(0, static_cast<int>(buf[0])), std::max(0, available) / slot_size});
   count_[i] = n;
-  double *dst = &slots_[std::size_t(i) * kMaxSlots * kSlotSize];
+  double *dst = slots(i);
   for (int k = 0; k < n; ++k, dst += kSlotSize) {
     std::copy(buf + 1 + k * slot_size, buf + 1 + (k + 1) * slot_size, dst);
     std::fill(dst + slot_size, dst + kSlotSize, 0.0);
@@ -42,12 +44,12 @@ int ContactHistory::unpack(int i, const double *buf, int available, int slot_siz
 
 double ContactHistory::memory_bytes() const
 {
-  return double(count_.capacity()) * sizeof(int) + double(slots_.capacity()) * sizeof(double);
+  return double(count_.capacity()) * sizeof(int) + double(capacity()) * kStride * sizeof(double);
 }
 
 const double *ContactHistory::find(int atom, double key) const
 {
-  const double *slot = &slots_[std::size_t(atom) * kMaxSlots * kSlotSize];
+  const double *slot = slots(atom);
   for (int k = 0; k < count_[atom]; ++k, slot += kSlotSize)
     if (slot[0] == key) return slot;
   return nullptr;
@@ -119,7 +121,7 @@ long ContactHistory::store(const std::vector<DetectedContact> &found, const Vect
       ++overflow;
       continue;
     }
-    double *slot = &slots_[(std::size_t(s) * kMaxSlots + count_[s]++) * kSlotSize];
+    double *slot = slots(s) + std::size_t(count_[s]++) * kSlotSize;
     slot[0] = fc.key;
     Vec3 tangential = Vec3::Zero(), rolling = Vec3::Zero();
     double twisting = 0.0;

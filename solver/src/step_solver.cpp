@@ -82,6 +82,7 @@ class StepSolver {
   const std::vector<unsigned char> all_rows_;
   Vector b_full_;                // the rhs with every row active and no fixed impulses
   std::vector<Vec6> row_scales_; // the sweeps' and residuals' row scales, every row active
+  std::vector<Vec6> diagonal_;   // A_ii per contact, every row active
   StopReason last_reason_ = StopReason::converged;
 };
 
@@ -193,10 +194,10 @@ int StepSolver::update_set(const Vector &lambda, const std::vector<unsigned char
   // alone (tiny) would only see the sign of rho and never find a cone's interior.
   Vector value = lambda;
   for (int c = 0; c < nc_; ++c) {
-    const Mat6 D = diagonal_block(sys_, c);
+    const Vec6 &D = diagonal_[c];
     for (int r = 0; r < rows_; ++r) {
       const Eigen::Index row = base(c) + r;
-      if (!mask[row]) value[row] += rho[row] / D(r, r);
+      if (!mask[row]) value[row] += rho[row] / D[r];
     }
   }
 
@@ -399,7 +400,9 @@ StepResult StepSolver::run(const Vector *warm)
   StepResult res;
   sys_.set_row_mask(all_rows_);
   b_full_ = spook_rhs(sys_);
-  row_scales_ = row_scales(sys_);
+  diagonal_.resize(nc_);
+  for (int c = 0; c < nc_; ++c) diagonal_[c] = diagonal_entries(sys_, c);
+  row_scales_ = row_scales(diagonal_, rows_);
   Vector lambda = initial_impulses(warm);
   // The projected warm start and its residual: the step never ends worse than the sweeps
   // alone would leave it from there.

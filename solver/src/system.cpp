@@ -14,17 +14,22 @@ void tangent_frame(const Vec3 &n, Vec3 &t1, Vec3 &t2)
   t2 = n.cross(t1);
 }
 
+void sphere_sphere_gap(const Body &A, const Body &B, Vec3 &normal, double &gap)
+{
+  const Vec3 d = A.x - B.x;
+  const double dist = d.norm();
+  normal = dist > 0 ? Vec3(d / dist) : Vec3::UnitZ();
+  gap = dist - A.radius - B.radius;
+}
+
 Contact sphere_sphere_contact(const std::vector<Body> &bodies, int a, int b)
 {
   const Body &A = bodies.at(a), &B = bodies.at(b);
-  const Vec3 d = A.x - B.x;
-  const double dist = d.norm();
   Contact c;
   c.a = a;
   c.b = b;
-  c.normal = dist > 0 ? Vec3(d / dist) : Vec3::UnitZ();
+  sphere_sphere_gap(A, B, c.normal, c.gap);
   tangent_frame(c.normal, c.t1, c.t2);
-  c.gap = dist - A.radius - B.radius;
   c.point = B.x + c.normal * (B.radius + 0.5 * c.gap);
   return c;
 }

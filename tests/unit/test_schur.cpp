@@ -68,6 +68,31 @@ TEST(Schur, PolydispersePilesWithWalls)
   expect_schur_matches_dense(pile_scene(40, p));
 }
 
+// The diagonal alone (row scales, trial impulses) is the dense A's, with 6 and 3 rows, and the
+// block's with rows masked out.
+TEST(Schur, DiagonalEntriesMatchDense)
+{
+  for (int rows : {6, 3}) {
+    SceneParams p;
+    p.rows = rows;
+    ContactSystem sys = pile_scene(40, p);
+    const test::Dense A = test::dense_A(sys);
+    for (int c = 0; c < sys.num_contacts(); ++c) {
+      const Vec6 d = diagonal_entries(sys, c);
+      for (int i = 0; i < rows; ++i)
+        EXPECT_NEAR(d[i], A(rows * c + i, rows * c + i), 1e-12 * A(rows * c + i, rows * c + i));
+      for (int i = rows; i < kMaxRows; ++i) EXPECT_EQ(d[i], 1.0);
+    }
+    std::vector<unsigned char> mask(sys.contact_dofs(), 1);
+    for (std::size_t i = 0; i < mask.size(); i += 4) mask[i] = 0;
+    sys.set_row_mask(mask);
+    for (int c = 0; c < sys.num_contacts(); ++c) {
+      const Mat6 D = diagonal_block(sys, c);
+      EXPECT_LT((diagonal_entries(sys, c) - D.diagonal()).norm(), 1e-12 * D.norm());
+    }
+  }
+}
+
 TEST(Schur, BlocksMatchDense)
 {
   SceneParams p;

@@ -58,6 +58,8 @@ class Cones {
 // not: it mixes the slip into the normal row, and projected sweeps with it converge to
 // impulses whose friction is off the slip.
 std::vector<Vec6> row_scales(const ContactSystem &sys);
+// The same from the diagonal entries of A (diagonal_entries, per contact).
+std::vector<Vec6> row_scales(const std::vector<Vec6> &diagonal, int rows);
 
 // How far feasible impulses are from solving the contact problem A lambda = b with the cones:
 // the step of the projected Jacobi map, || lambda - P(lambda + rho / scale) ||_2 / ||lambda||_2

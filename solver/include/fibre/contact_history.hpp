@@ -6,6 +6,7 @@
 #pragma once
 
 #include <array>
+#include <memory>
 #include <vector>
 
 #include "fibre/detection.hpp"
@@ -52,9 +53,14 @@ class ContactHistory {
              int nlocal, const std::vector<std::array<double, kMaxRows>> *springs = nullptr);
 
  private:
+  static constexpr std::size_t kStride = std::size_t(kMaxSlots) * kSlotSize;
   const double *find(int atom, double key) const;
+  double *slots(int atom) const { return slots_.get() + std::size_t(atom) * kStride; }
   std::vector<int> count_;
-  std::vector<double> slots_; // kMaxSlots * kSlotSize per atom
+  // kStride values per atom, of which the first count_ slots are set. Not zero-filled: LAMMPS
+  // grows per-atom arrays by 16384 atoms at a time, and filling that room (29 MB) cost 8% of a
+  // 3 s material run in page faults; untouched room is never read.
+  std::unique_ptr<double[]> slots_;
 };
 
 } // namespace fibre
