@@ -110,13 +110,24 @@ LammpsDetection::contacts(const std::vector<fibre::Body> &bodies, double h, doub
     exchange_.forward(kick);
     kick_.resize(nbody);
     for (int k = 0; k < nbody; ++k) kick_[k] = kick[6 * k];
-    found.clear();
+    // the second pass adds what the kicks reach; the first pass's contacts stand
     pair_contacts(bodies, h, damping, found);
     wall_contacts(bodies, h, damping, found);
   }
   fibre::sort_contacts(found);
   last_found_ = found.size();
   return found;
+}
+
+// In the impact pass (kicks set) a candidate is new only if its kick brings it into reach:
+// is_contact grows with the kick, so the first pass took every other contact already.
+bool LammpsDetection::accept(const fibre::Body &a, const fibre::Body *b, const fibre::Vec3 &n,
+                             double gap, double h, double damping, double kick,
+                             double wall_approach) const
+{
+  if (kick_.empty()) return fibre::is_contact(a, b, n, gap, h, damping, 0.0, wall_approach);
+  return kick > 0.0 && fibre::is_contact(a, b, n, gap, h, damping, kick, wall_approach) &&
+         !fibre::is_contact(a, b, n, gap, h, damping, 0.0, wall_approach);
 }
 
 // Every contact is kept by exactly one process: a pair of two owned atoms is listed once; with
@@ -141,6 +152,8 @@ void LammpsDetection::pair_contacts(const std::vector<fibre::Body> &bodies, doub
       const int j = jlist[jj] & NEIGHMASK;
       const int bi = atom_body_[i], bj = atom_body_[j];
       if (bi < 0 && bj < 0) continue;
+      if (!kick_.empty() && !(bi >= 0 && kick_[bi] > 0) && !(bj >= 0 && kick_[bj] > 0))
+        continue;                     // the impact pass: nothing new within reach
       if (tag[i] == tag[j]) continue; // a periodic image of itself
       if (j >= nlocal && !newton_pair && tag[i] > tag[j]) continue;
       const double dx = x[i][0] - x[j][0], dy = x[i][1] - x[j][1], dz = x[i][2] - x[j][2];
@@ -157,8 +170,7 @@ void LammpsDetection::pair_contacts(const std::vector<fibre::Body> &bodies, doub
         fibre::Vec3 normal;
         double gap = 0.0;
         fibre::sphere_sphere_gap(bodies[a], bodies[b], normal, gap);
-        if (!fibre::is_contact(bodies[a], &bodies[b], normal, gap, h, damping, kick(a) + kick(b)))
-          continue;
+        if (!accept(bodies[a], &bodies[b], normal, gap, h, damping, kick(a) + kick(b))) continue;
         fc.contact = fibre::sphere_sphere_contact(bodies, a, b);
         fc.tag_a = tag[low];
         fc.partner = static_cast<double>(tag[high]);
@@ -175,8 +187,8 @@ void LammpsDetection::pair_contacts(const std::vector<fibre::Body> &bodies, doub
         const fibre::Vec3 xo(x[o][0], x[o][1], x[o][2]);
         fc.contact.wall_v = vo + wo.cross(fc.contact.point - xo);
         fc.contact.wall_omega = wo;
-        if (!fibre::is_contact(bodies[atom_body_[g]], nullptr, n, fc.contact.gap, h, damping,
-                               kick(atom_body_[g]), n.dot(fc.contact.wall_v)))
+        if (!accept(bodies[atom_body_[g]], nullptr, n, fc.contact.gap, h, damping,
+                    kick(atom_body_[g]), n.dot(fc.contact.wall_v)))
           continue;
         fc.tag_a = tag[g];
         fc.partner = static_cast<double>(tag[o]);
@@ -193,8 +205,8 @@ void LammpsDetection::add_wall_contact(const std::vector<fibre::Body> &bodies, i
                                        double h, double damping,
                                        std::vector<fibre::DetectedContact> &found) const
 {
-  if (!fibre::is_contact(bodies[body], nullptr, n, distance - bodies[body].radius, h, damping,
-                         kick(body), n.dot(wall_v)))
+  if (!accept(bodies[body], nullptr, n, distance - bodies[body].radius, h, damping, kick(body),
+              n.dot(wall_v)))
     return;
   fibre::DetectedContact fc;
   fc.contact = fibre::sphere_wall_contact(bodies, body, n, distance);

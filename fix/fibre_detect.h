@@ -51,6 +51,9 @@ class LammpsDetection : protected LAMMPS_NS::Pointers {
                         std::vector<fibre::DetectedContact> &found) const;
 
   double kick(int body) const { return kick_.empty() ? 0.0 : kick_[body]; }
+  // fibre::is_contact, and in the impact pass only for the candidates the kicks add
+  bool accept(const fibre::Body &a, const fibre::Body *b, const fibre::Vec3 &n, double gap,
+              double h, double damping, double kick, double wall_approach = 0.0) const;
 
   // The host's walls, one source file per host: regions (LAMMPS) or meshes (LIGGGHTS); the
   // other host's kind is an error at init.

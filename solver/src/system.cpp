@@ -108,6 +108,14 @@ void ContactSystem::compute_derived()
     q.frame.row(2) = k.t2.transpose();
     q.ra = k.point - bodies_[k.a].x;
     q.rb = k.is_wall() ? Vec3::Zero() : Vec3(k.point - bodies_[k.b].x);
+  }
+  compute_rows();
+}
+
+void ContactSystem::compute_rows()
+{
+  for (int c = 0; c < num_contacts(); ++c) {
+    const Contact &k = contacts_[c];
     const double d = params_.damping_of(k);
     for (int r = 0; r < rows_; ++r) {
       const Eigen::Index row = Eigen::Index(rows_) * c + r;
@@ -134,7 +142,7 @@ void ContactSystem::set_row_mask(const std::vector<unsigned char> &active)
   if (static_cast<Eigen::Index>(active.size()) != contact_dofs())
     throw std::invalid_argument("row mask size differs from the number of contact rows");
   mask_ = active;
-  compute_derived();
+  compute_rows();
   for (Eigen::Index row = 0; row < contact_dofs(); ++row)
     if (!row_active(row)) rhs_[row] = 0.0;
 }

@@ -190,7 +190,8 @@ class ContactSystem {
   bool row_active(Eigen::Index row) const { return mask_.empty() || mask_[row] != 0; }
 
  private:
-  void compute_derived();
+  void compute_derived(); // everything below from the bodies and contacts, then compute_rows
+  void compute_rows();    // Sigma and the row weights, from the row mask
 
   int rows_ = 6;
   int num_owned_ = 0;
