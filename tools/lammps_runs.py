@@ -18,6 +18,7 @@ SCENE_FILES = {
     "drum": ["in.drum", "in.drum.native", "scene.drum", "run.drum"],
     "shear": ["in.shear", "in.shear.native", "scene.shear", "run.shear"],
     "mixer": ["in.mixer", "in.mixer.native", "scene.mixer", "run.mixer"],
+    "janssen": ["in.janssen", "in.janssen.native", "scene.janssen", "run.janssen", "janssen.py"],
 }
 
 
