@@ -432,20 +432,14 @@ StepResult StepSolver::run(const Vector *warm)
       res.restarted = true;
     }
   }
-  if (opt_.accuracy > 0) {
-    if (res.converged && !(res.error_estimate <= opt_.accuracy)) {
-      res.converged = false;
-      res.reason =
-          res.sweep_reason == StopReason::converged ? StopReason::stagnation : res.sweep_reason;
-    }
-  } else if (!sweeps_only() && res.converged && opt_.sweeps > 0 &&
-             res.complementarity > kRescueFactor * opt_.sweep_tol) {
+  // The step's own target: its accuracy (tol); else sweep_tol, within kRescueFactor of it after
+  // a linear pass. Sweeps that stopped moving above it stagnated.
+  const bool missed = opt_.accuracy > 0 ? !(res.error_estimate <= opt_.accuracy)
+                      : sweeps_only()
+                          ? res.complementarity > opt_.sweep_tol
+                          : opt_.sweeps > 0 && res.complementarity > kRescueFactor * opt_.sweep_tol;
+  if (missed && res.converged) {
     res.converged = false;
-    res.reason =
-        res.sweep_reason == StopReason::converged ? StopReason::stagnation : res.sweep_reason;
-  } else if (sweeps_only() && res.complementarity > opt_.sweep_tol) {
-    res.converged = false;
-    // sweeps that stopped moving above the tolerance stagnated
     res.reason =
         res.sweep_reason == StopReason::converged ? StopReason::stagnation : res.sweep_reason;
   }
