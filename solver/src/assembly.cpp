@@ -36,9 +36,18 @@ Vector assemble_sigma(const ContactSystem &sys)
   return sys.sigma();
 }
 
-SparseMatrix assemble_A(const ContactSystem &sys)
+SparseMatrix assemble_A(const ContactSystem &sys, const std::vector<int> &owners)
 {
-  const SparseMatrix G = assemble_G(sys);
+  SparseMatrix G = assemble_G(sys);
+  if (!owners.empty()) {
+    std::vector<Eigen::Triplet<double>> to_owner;
+    for (int i = 0; i < sys.num_bodies(); ++i)
+      for (int d = 0; d < kBodyDofs; ++d)
+        to_owner.emplace_back(kBodyDofs * i + d, kBodyDofs * owners[i] + d, 1.0);
+    SparseMatrix P(sys.body_dofs(), sys.body_dofs());
+    P.setFromTriplets(to_owner.begin(), to_owner.end());
+    G = G * P;
+  }
   SparseMatrix A = G * sys.inv_mass().asDiagonal() * SparseMatrix(G.transpose());
   // Diagonal entries always exist (Sigma > 0), so A's pattern holds the full diagonal.
   A += SparseMatrix(sys.sigma().asDiagonal());

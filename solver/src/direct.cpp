@@ -300,11 +300,12 @@ std::vector<double> DistributedCholesky::solve(const std::vector<long> &rhs_inde
 
 namespace {
 
-Vector solve_contact_form(const ContactSystem &sys, const Vector &b, MPI_Comm comm)
+Vector solve_contact_form(const ContactSystem &sys, const Exchange &ex, const Vector &b,
+                          MPI_Comm comm)
 {
   std::vector<long> rows, cols, index(sys.contact_dofs());
   std::vector<double> values;
-  upper_triplets(assemble_A(sys), rows, cols, values);
+  upper_triplets(assemble_A(sys, ex.local_owners()), rows, cols, values);
   for (Eigen::Index i = 0; i < sys.contact_dofs(); ++i) index[i] = static_cast<long>(i);
   DistributedCholesky chol(comm);
   chol.factorize(static_cast<long>(sys.contact_dofs()), rows, cols, values);
@@ -368,7 +369,7 @@ Vector direct_solve(Form form, const ContactSystem &sys, const Exchange &ex, con
                                 std::to_string(sys.contact_dofs()));
   int nprocs = 1;
   MPI_Comm_size(comm, &nprocs);
-  if (form == Form::contact && nprocs == 1) return solve_contact_form(sys, b, comm);
+  if (form == Form::contact && nprocs == 1) return solve_contact_form(sys, ex, b, comm);
   return solve_body_form(sys, ex, b, comm);
 }
 

@@ -22,8 +22,10 @@ SparseMatrix assemble_G(const ContactSystem &sys);
 Vector assemble_inv_mass(const ContactSystem &sys);
 Vector assemble_sigma(const ContactSystem &sys);
 
-// A = G M^-1 G^T + Sigma, both triangles stored.
-SparseMatrix assemble_A(const ContactSystem &sys);
+// A = G M^-1 G^T + Sigma, both triangles stored. With `owners` (Exchange::local_owners(): a
+// body per local body, empty for none) a periodic image's columns of G are its body's, so the
+// contacts on a body and on its image couple as they do through the one body.
+SparseMatrix assemble_A(const ContactSystem &sys, const std::vector<int> &owners = {});
 
 // K = M + G^T Sigma^-1 G, both triangles stored. M enters on owned bodies only, so ghost
 // rows and columns hold this process's contact terms alone (partial sums for the owner).
