@@ -1,8 +1,9 @@
 // The LIGGGHTS host's own walls: triangle meshes of fix mesh/surface (static, or moved by fix
 // move/mesh, or with a conveyor's surface velocity). Each step the process's local and ghost
-// triangles, with their node velocities, go into a grid of the library's (fibre/mesh.hpp); each
-// owned sphere keeps one contact per face, edge or vertex it touches, keyed by the triangle's
-// global ID (warm starts follow the triangle). A LAMMPS region needs the LAMMPS front end.
+// triangles are read with their node velocities, and go into a grid of the library's
+// (fibre/mesh.hpp) when a node has moved; each owned sphere keeps one contact per face, edge or
+// vertex it touches, keyed by the triangle's global ID (warm starts follow the triangle). A
+// LAMMPS region needs the LAMMPS front end.
 #include <mpi.h>
 
 #include <algorithm>
@@ -23,11 +24,19 @@ using namespace LAMMPS_NS;
 
 namespace fibre_lmp {
 
+// A mesh's triangles of the last search and their grid, rebuilt only when a node has moved
+// (a static mesh's grid was rebuilt every step, 4% of the hopper's run, and twice with impacts).
+struct MeshCache {
+  std::vector<fibre::Triangle> triangles;
+  fibre::TriangleGrid grid;
+  bool built = false;
+};
+
 struct LammpsDetection::HostWalls {
   std::vector<FixMeshSurface *> meshes; // per wall, or nullptr
   std::vector<bool> described;          // per wall: its triangles and open edges logged
-  std::vector<fibre::Triangle> triangles;
-  fibre::TriangleGrid grid;
+  std::vector<MeshCache> cache;         // per wall
+  std::vector<fibre::Triangle> fresh;   // the triangles as read this time
   std::vector<fibre::TriangleHit> hits;
   fibre::MeshScratch scratch;
 };
@@ -45,6 +54,7 @@ void LammpsDetection::init_host_wall(int w)
   if (!host_walls_) host_walls_ = std::make_unique<HostWalls>();
   host_walls_->meshes.resize(walls_.size(), nullptr);
   host_walls_->described.assign(walls_.size(), false);
+  host_walls_->cache.assign(walls_.size(), MeshCache());
   const std::string &id = walls_[w].id;
   if (walls_[w].kind == fibre::WallKind::region)
     fail(error, FLERR,
@@ -90,6 +100,17 @@ void read_triangles(TriMesh *mesh, std::vector<fibre::Triangle> &out)
                      : fibre::Vec3::Zero();
     }
   }
+}
+
+// The same triangles at the same places (their velocities may differ).
+bool same_places(const std::vector<fibre::Triangle> &a, const std::vector<fibre::Triangle> &b)
+{
+  if (a.size() != b.size()) return false;
+  for (std::size_t t = 0; t < a.size(); ++t)
+    if (a[t].id != b[t].id || a[t].p[0] != b[t].p[0] || a[t].p[1] != b[t].p[1] ||
+        a[t].p[2] != b[t].p[2])
+      return false;
+  return true;
 }
 
 // The whole mesh on process 0 (every process's local triangles): its size and open edges for
@@ -139,26 +160,32 @@ void LammpsDetection::host_wall_contacts(int w, const std::vector<fibre::Body> &
     describe_mesh(lmp, fix->triMesh(), walls_[w].id);
     host.described[w] = true;
   }
-  read_triangles(fix->triMesh(), host.triangles);
-  if (host.triangles.empty()) return;
+  MeshCache &mesh = host.cache[w];
+  read_triangles(fix->triMesh(), host.fresh);
+  const bool moved = !mesh.built || !same_places(host.fresh, mesh.triangles);
+  mesh.triangles.swap(host.fresh);
+  if (mesh.triangles.empty()) return;
+  if (moved) {
+    mesh.grid.build(mesh.triangles, 0.0);
+    mesh.built = true;
+  }
   double speed = 0.0; // the fastest node bounds the surface speed near any sphere
-  for (const fibre::Triangle &tri : host.triangles)
+  for (const fibre::Triangle &tri : mesh.triangles)
     for (const fibre::Vec3 &v : tri.v) speed = std::max(speed, v.norm());
-  host.grid.build(host.triangles, 0.0);
   const int mesh_type = fix->min_type();
   const int nowned = exchange_.num_owned();
   for (int k = 0; k < nowned; ++k) {
     const fibre::Body &b = bodies[k];
     const double reach = fibre::region_cutoff(b, h, damping, neighbor->skin, speed);
     host.hits.clear();
-    fibre::mesh_hits(host.triangles, host.grid, b.x, reach, host.hits, host.scratch);
+    fibre::mesh_hits(mesh.triangles, mesh.grid, b.x, reach, host.hits, host.scratch);
     for (const fibre::TriangleHit &hit : host.hits) {
       const std::size_t before = found.size();
       add_wall_contact(bodies, k, hit.normal, hit.distance, w, 0, hit.velocity, fibre::Vec3::Zero(),
                        h, damping, found);
       if (found.size() == before) continue;
       fibre::DetectedContact &fc = found.back();
-      fc.partner = fc.key = fibre::mesh_key(w, host.triangles[hit.triangle].id);
+      fc.partner = fc.key = fibre::mesh_key(w, mesh.triangles[hit.triangle].id);
       fc.contact.wall_type = mesh_type;
     }
   }
