@@ -123,7 +123,8 @@ void FibreOutput::fill_local(const std::vector<fibre::DetectedContact> &found,
 
 void FibreOutput::export_step(const std::string &prefix, const fibre::ContactSystem &sys,
                               const std::vector<fibre::DetectedContact> &found,
-                              const fibre::Vector *lambda, const fibre::Vector &warm)
+                              const fibre::Vector *lambda, const fibre::Vector &warm,
+                              const std::vector<int> &owners)
 {
   const std::string base = prefix + "." +
                            std::to_string(static_cast<long long>(update->ntimestep)) + "." +
@@ -154,6 +155,18 @@ void FibreOutput::export_step(const std::string &prefix, const fibre::ContactSys
       std::fprintf(fp, " %.17g", warm.size() > at + r ? warm[at + r] : 0.0);
     std::fprintf(fp, "\n");
   }
+  std::fclose(fp);
+  // the ghosts that are periodic images of this process's own bodies, for an exact replay
+  std::vector<int> images;
+  for (int i = 0; i < static_cast<int>(owners.size()); ++i)
+    if (owners[i] != i) images.push_back(i);
+  if (images.empty()) return;
+  fp = std::fopen((base + ".images").c_str(), "w");
+  if (!fp)
+    fail_one(error, FLERR, "Fix fibre_contact could not write export file " + base + ".images");
+  std::fprintf(fp, "# fibre_contact periodic images, step %lld, process %d: image body\n",
+               static_cast<long long>(update->ntimestep), comm->me);
+  for (int i : images) std::fprintf(fp, "%d %d\n", i, owners[i]);
   std::fclose(fp);
 }
 

@@ -68,10 +68,12 @@ class FibreOutput : protected LAMMPS_NS::Pointers {
   void fill_local(const std::vector<fibre::DetectedContact> &found, const fibre::Vector *lambda,
                   int rows, double **&array_local, int &size_local_rows);
   // prefix.STEP.RANK.sys (the system) and .lambda (the atoms of every contact, its impulses and
-  // the warm start the solve began from): together the whole step, to replay it.
+  // the warm start the solve began from): together the whole step, to replay it; and .images
+  // (image body, per line) where ghosts are periodic images of this process's bodies (owners:
+  // Exchange::local_owners).
   void export_step(const std::string &prefix, const fibre::ContactSystem &sys,
                    const std::vector<fibre::DetectedContact> &found, const fibre::Vector *lambda,
-                   const fibre::Vector &warm);
+                   const fibre::Vector &warm, const std::vector<int> &owners);
 
   void write_restart(FILE *fp) const;
   void read_restart(const char *buf);

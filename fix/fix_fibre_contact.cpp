@@ -536,7 +536,8 @@ void FixFibreContact::final_integrate()
   output_->fill_local(found, any ? &res.lambda : nullptr, model.rows, array_local, size_local_rows);
   output_->report_solve(res);
   if (do_export)
-    output_->export_step(settings_.export_prefix, sys, found, any ? &res.lambda : nullptr, warm);
+    output_->export_step(settings_.export_prefix, sys, found, any ? &res.lambda : nullptr, warm,
+                         exchange_->local_owners());
   if (overflow_count_ > 0 && !overflow_warned_ && comm->me == 0) {
     warn(error, FLERR,
          "Fix fibre_contact: more than " + std::to_string(fibre::ContactHistory::kMaxSlots) +

@@ -125,6 +125,7 @@ void print_row(const char *name, const StudyRow &r, std::FILE *csv)
 void newton_basin(const StepState &state)
 {
   const ContactSystem &sys = state.sys;
+  const Exchange &ex = state.exchange();
   const Cones cones(sys);
   const Vector b = spook_rhs(sys);
   const std::vector<Vec6> scale = row_scales(sys);
@@ -133,15 +134,15 @@ void newton_basin(const StepState &state)
     Vector lambda = state.warm;
     for (int c = 0; c < sys.num_contacts(); ++c) cones.project(lambda.data() + sys.rows() * c, c);
     int sweeps = 0;
-    double r = complementarity(sys, serial_exchange(), cones, b, lambda, scale);
+    double r = complementarity(sys, ex, cones, b, lambda, scale);
     while (start > 0 && r > start && sweeps < 100000) {
-      pgs(sys, serial_exchange(), cones, b, scale, lambda, PgsControl{10, 0.0, 1 << 30});
+      pgs(sys, ex, cones, b, scale, lambda, PgsControl{10, 0.0, 1 << 30});
       sweeps += 10;
-      r = complementarity(sys, serial_exchange(), cones, b, lambda, scale);
+      r = complementarity(sys, ex, cones, b, lambda, scale);
     }
     std::printf("from the warm start + %5d sweeps (%.1e):", sweeps, r);
     for (int it = 0; it < 8; ++it) {
-      const NewtonResult nr = semismooth_newton(sys, cones, b, lambda, 1e-10, 1);
+      const NewtonResult nr = semismooth_newton(sys, cones, b, lambda, 1e-10, 1, ex);
       std::printf(" %.1e", nr.complementarity);
       if (nr.converged) break;
     }
@@ -160,8 +161,9 @@ int run(const Options &opt)
     return 0;
   }
   const auto t0 = Clock::now();
-  const Reference ref =
-      nonsmooth_reference(sys, state.lambda, ReferenceOptions{opt.target, 2000000, 30});
+  const Reference ref = nonsmooth_reference(
+      sys, state.lambda, ReferenceOptions{opt.target, 2000000, 30}, state.exchange());
+  if (state.images) std::printf("periodic images: from %s.images\n", opt.state.c_str());
   std::printf("reference (%.1f s): projected Gauss-Seidel %d sweeps, residual %.2e; semismooth "
               "Newton %d iterations, residual %.2e%s\n",
               seconds_since(t0), ref.sweeps, ref.complementarity_pgs, ref.newton.iterations,
@@ -181,9 +183,9 @@ int run(const Options &opt)
              "converged,dv_trans,dv_rot,lambda_n,lambda_t,lambda_roll,lambda_twist\n");
   StudyRow run_row;
   run_row.setting = "the run's own solve (export)";
-  run_row.error = step_accuracy(sys, state.lambda, ref.lambda);
+  run_row.error = step_accuracy(sys, state.lambda, ref.lambda, state.exchange());
   print_row("(the run's own impulses)", run_row, nullptr);
-  run_row.error = step_accuracy(sys, state.warm, ref.lambda);
+  run_row.error = step_accuracy(sys, state.warm, ref.lambda, state.exchange());
   print_row("(the warm start alone)", run_row, nullptr);
   for (const std::string &text : opt.settings) {
     const Settings s = parse_settings(words(text));

@@ -11,9 +11,39 @@
 
 namespace fibre {
 
+namespace {
+
+// PREFIX.images: "image body" per line, an image being a ghost of the system and its body an
+// owned one; none when the file is absent.
+std::shared_ptr<const ImageExchange> read_images(const std::string &path, const ContactSystem &sys)
+{
+  std::ifstream in(path);
+  if (!in) return nullptr;
+  std::vector<int> owners(sys.num_bodies());
+  for (int i = 0; i < sys.num_bodies(); ++i) owners[i] = i;
+  std::string line;
+  for (int number = 1; std::getline(in, line); ++number) {
+    if (line.empty() || line[0] == '#') continue;
+    std::istringstream words(line);
+    std::string w[3];
+    words >> w[0] >> w[1] >> w[2];
+    long image = -1, body = -1;
+    if (!to_long(w[0], image) || !to_long(w[1], body) || !w[2].empty() ||
+        image < sys.num_owned_bodies() || image >= sys.num_bodies() || body < 0 ||
+        body >= sys.num_owned_bodies())
+      throw std::runtime_error(path + ", line " + std::to_string(number) +
+                               ": expected '<image> <body>', a ghost and an owned body");
+    owners[image] = static_cast<int>(body);
+  }
+  return std::make_shared<const ImageExchange>(std::move(owners));
+}
+
+} // namespace
+
 StepState read_step_state(const std::string &prefix)
 {
-  StepState st{read_system_file(prefix + ".sys"), Vector(), Vector()};
+  StepState st{read_system_file(prefix + ".sys"), Vector(), Vector(), nullptr};
+  st.images = read_images(prefix + ".images", st.sys);
   const int rows = st.sys.rows(), nc = st.sys.num_contacts();
   st.lambda = Vector::Zero(st.sys.contact_dofs());
   st.warm = Vector::Zero(st.sys.contact_dofs());
@@ -76,7 +106,7 @@ StudyRow measure_setting(const StepState &state, const StepOptions &opt, const V
   for (int i = 0; i < std::max(1, repeat); ++i) {
     ContactSystem sys = state.sys; // the solve sets masks and the rhs
     const auto t0 = Clock::now();
-    res = solve_step(sys, serial_exchange(), opt, &state.warm, MPI_COMM_SELF);
+    res = solve_step(sys, state.exchange(), opt, &state.warm, MPI_COMM_SELF);
     row.seconds = std::min(row.seconds, seconds_since(t0));
   }
   row.k_products = row.seconds / k_seconds;
@@ -86,7 +116,7 @@ StudyRow measure_setting(const StepState &state, const StepOptions &opt, const V
   row.complementarity = res.complementarity;
   row.error_estimate = res.error_estimate;
   row.converged = res.converged;
-  row.error = step_accuracy(state.sys, res.lambda, reference);
+  row.error = step_accuracy(state.sys, res.lambda, reference, state.exchange());
   return row;
 }
 

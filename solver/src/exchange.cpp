@@ -15,6 +15,22 @@ std::vector<long> global_body_index(const Exchange &ex, int num_owned, int num_b
   return index;
 }
 
+void ImageExchange::forward(Vector &body_vec) const
+{
+  for (std::size_t i = 0; i < owners_.size(); ++i)
+    if (owners_[i] != int(i))
+      body_vec.segment<6>(6 * Eigen::Index(i)) = body_vec.segment<6>(6 * Eigen::Index(owners_[i]));
+}
+
+void ImageExchange::reverse_sum(Vector &body_vec) const
+{
+  for (std::size_t i = 0; i < owners_.size(); ++i)
+    if (owners_[i] != int(i)) {
+      body_vec.segment<6>(6 * Eigen::Index(owners_[i])) += body_vec.segment<6>(6 * Eigen::Index(i));
+      body_vec.segment<6>(6 * Eigen::Index(i)).setZero();
+    }
+}
+
 const Exchange &serial_exchange()
 {
   static const SerialExchange ex;

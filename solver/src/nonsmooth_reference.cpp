@@ -84,9 +84,9 @@ double StepAccuracy::impulse() const
   return std::max({lambda_n, lambda_t, lambda_roll, lambda_twist});
 }
 
-StepAccuracy step_accuracy(const ContactSystem &sys, const Vector &lambda, const Vector &ref)
+StepAccuracy step_accuracy(const ContactSystem &sys, const Vector &lambda, const Vector &ref,
+                           const Exchange &ex)
 {
-  const Exchange &ex = serial_exchange();
   const Vector dv = velocity_change(sys, ex, lambda), dv_ref = velocity_change(sys, ex, ref);
   double e[2][2] = {{0, 0}, {0, 0}}; // [trans/rot][err2, ref2]
   for (int i = 0; i < sys.num_owned_bodies(); ++i)
@@ -116,10 +116,10 @@ StepAccuracy step_accuracy(const ContactSystem &sys, const Vector &lambda, const
 }
 
 NewtonResult semismooth_newton(const ContactSystem &sys, const Cones &cones, const Vector &b,
-                               Vector &lambda, double target, int max_iter)
+                               Vector &lambda, double target, int max_iter, const Exchange &ex)
 {
   NewtonResult res;
-  const SparseMatrix A = assemble_A(sys);
+  const SparseMatrix A = assemble_A(sys, ex.local_owners());
   const std::vector<Vec6> scale = row_scales(sys);
   const int rows = sys.rows();
   Vector inv_scale(lambda.size());
@@ -156,7 +156,7 @@ NewtonResult semismooth_newton(const ContactSystem &sys, const Cones &cones, con
       }
     }
     if (!moved) { // no descent: projected Gauss-Seidel makes progress instead
-      pgs(sys, serial_exchange(), cones, b, scale, lambda, PgsControl{10, 0.0, 1000});
+      pgs(sys, ex, cones, b, scale, lambda, PgsControl{10, 0.0, 1000});
     }
   }
 }
@@ -168,7 +168,7 @@ bool Reference::confirmed() const
 }
 
 Reference nonsmooth_reference(const ContactSystem &sys, const Vector &start,
-                              const ReferenceOptions &opt)
+                              const ReferenceOptions &opt, const Exchange &ex)
 {
   Reference ref;
   const Cones cones(sys);
@@ -181,19 +181,19 @@ Reference nonsmooth_reference(const ContactSystem &sys, const Vector &start,
   // enough that agreeing with the sweeps' end point is a check of that point.
   Vector newton_lambda;
   while (ref.sweeps < opt.max_sweeps) {
-    const PgsResult r = pgs(sys, serial_exchange(), cones, b, scale, pgs_lambda,
+    const PgsResult r = pgs(sys, ex, cones, b, scale, pgs_lambda,
                             PgsControl{std::min(500, opt.max_sweeps - ref.sweeps), 1e-15, 1 << 30});
     ref.sweeps += r.sweeps;
-    ref.complementarity_pgs = complementarity(sys, serial_exchange(), cones, b, pgs_lambda, scale);
+    ref.complementarity_pgs = complementarity(sys, ex, cones, b, pgs_lambda, scale);
     if (newton_lambda.size() == 0 && ref.complementarity_pgs <= 1e-6) newton_lambda = pgs_lambda;
     if (ref.complementarity_pgs <= opt.target || r.reason == StopReason::non_finite) break;
   }
   if (newton_lambda.size() == 0) newton_lambda = pgs_lambda;
-  ref.newton = semismooth_newton(sys, cones, b, newton_lambda, opt.target, opt.max_newton);
+  ref.newton = semismooth_newton(sys, cones, b, newton_lambda, opt.target, opt.max_newton, ex);
   // Newton's iterate is feasible only in the limit: its projection is the answer
   for (int c = 0; c < sys.num_contacts(); ++c)
     cones.project(newton_lambda.data() + sys.rows() * c, c);
-  ref.agreement = step_accuracy(sys, pgs_lambda, newton_lambda);
+  ref.agreement = step_accuracy(sys, pgs_lambda, newton_lambda, ex);
   ref.lambda = ref.newton.converged ? newton_lambda : pgs_lambda;
   return ref;
 }

@@ -133,6 +133,26 @@ TEST(AccuracyStudy, BadStateFilesAreNamed)
   } catch (const std::runtime_error &e) {
     EXPECT_NE(std::string(e.what()).find(".lambda, line 2"), std::string::npos) << e.what();
   }
+  // an images file must pair a ghost with an owned body (this system has no ghosts)
+  {
+    const StepState st = read_step_state(kState);
+    std::ofstream lam(path + ".lambda");
+    lam << "# header\n";
+    for (int c = 0; c < st.sys.num_contacts(); ++c) {
+      lam << c << " 0 0 0";
+      for (int r = 0; r < st.sys.rows(); ++r) lam << " 0";
+      lam << "\n";
+    }
+    std::ofstream images(path + ".images");
+    images << "# image body\n0 1\n";
+  }
+  try {
+    read_step_state(path);
+    ADD_FAILURE() << "accepted a bad .images";
+  } catch (const std::runtime_error &e) {
+    EXPECT_NE(std::string(e.what()).find(".images, line 2"), std::string::npos) << e.what();
+  }
   std::remove((path + ".sys").c_str());
   std::remove((path + ".lambda").c_str());
+  std::remove((path + ".images").c_str());
 }

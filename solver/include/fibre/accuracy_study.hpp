@@ -6,6 +6,7 @@
 // measured in the same run. Serial.
 #pragma once
 
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -18,9 +19,14 @@ struct StepState {
   ContactSystem sys;
   Vector lambda; // the impulses the run found (zero when the export has none)
   Vector warm;   // the warm start of the run's solve (zero when the export has none)
+  // A serial periodic step's images (PREFIX.images): every local body's body; empty: none.
+  std::shared_ptr<const ImageExchange> images;
+  // the step's exchange: serial, with the images where it has them
+  const Exchange &exchange() const { return images ? *images : serial_exchange(); }
 };
 
-// PREFIX.sys and PREFIX.lambda (doc/system_format.md, doc/fix_fibre_contact.md "Export").
+// PREFIX.sys and PREFIX.lambda, and PREFIX.images where the run wrote one (doc/system_format.md,
+// doc/fix_fibre_contact.md "Export").
 // Throws std::runtime_error with the file and line of a problem.
 StepState read_step_state(const std::string &prefix);
 

@@ -5,6 +5,9 @@
 // use SerialExchange.
 #pragma once
 
+#include <utility>
+#include <vector>
+
 #include "fibre/system.hpp"
 
 namespace fibre {
@@ -52,6 +55,24 @@ class SerialExchange final : public Exchange {
   void sum(double *, int) const override {}
   void max(double *, int) const override {}
   long exclusive_prefix_sum(long) const override { return 0; }
+};
+
+// One process whose ghosts are periodic images of its own bodies: a serial periodic step
+// replayed from an export (its PREFIX.images). An image holds its body's velocity, and what
+// its contacts do to it is done to the body.
+class ImageExchange final : public Exchange {
+ public:
+  // owners: for every local body, itself or, for an image, its body (an owned one)
+  explicit ImageExchange(std::vector<int> owners) : owners_(std::move(owners)) {}
+  void forward(Vector &body_vec) const override;
+  void reverse_sum(Vector &body_vec) const override;
+  void sum(double *, int) const override {}
+  void max(double *, int) const override {}
+  long exclusive_prefix_sum(long) const override { return 0; }
+  const std::vector<int> &local_owners() const override { return owners_; }
+
+ private:
+  std::vector<int> owners_;
 };
 
 // Index of every local body (owned, then ghosts) in one global numbering of all owned bodies

@@ -9,6 +9,7 @@
 #pragma once
 
 #include "fibre/cones.hpp"
+#include "fibre/exchange.hpp"
 #include "fibre/system.hpp"
 
 namespace fibre {
@@ -22,8 +23,10 @@ struct StepAccuracy {
   double impulse() const; // the largest of the impulse groups that carry any impulse
 };
 
-// lambda against the reference ref (both rows per contact of sys).
-StepAccuracy step_accuracy(const ContactSystem &sys, const Vector &lambda, const Vector &ref);
+// lambda against the reference ref (both rows per contact of sys). `ex`: one process, with
+// the step's periodic images where it has them (ImageExchange); so below.
+StepAccuracy step_accuracy(const ContactSystem &sys, const Vector &lambda, const Vector &ref,
+                           const Exchange &ex = serial_exchange());
 
 struct NewtonResult {
   int iterations = 0;
@@ -35,7 +38,8 @@ struct NewtonResult {
 // at most target, or max_iter iterations. A step whose line search fails is replaced by ten
 // projected Gauss-Seidel sweeps.
 NewtonResult semismooth_newton(const ContactSystem &sys, const Cones &cones, const Vector &b,
-                               Vector &lambda, double target, int max_iter);
+                               Vector &lambda, double target, int max_iter,
+                               const Exchange &ex = serial_exchange());
 
 struct ReferenceOptions {
   double target = 1e-10;    // complementarity residual of both methods
@@ -55,6 +59,7 @@ struct Reference {
 // The sweeps start from `start` (for example the run's own impulses); Newton starts from the
 // sweeps' iterate at a residual of 1e-6, and its end point must agree with theirs.
 Reference nonsmooth_reference(const ContactSystem &sys, const Vector &start,
-                              const ReferenceOptions &opt = {});
+                              const ReferenceOptions &opt = {},
+                              const Exchange &ex = serial_exchange());
 
 } // namespace fibre
