@@ -61,7 +61,6 @@ PgsResult apgd(const ContactSystem &sys, const Exchange &ex, const Cones &cones,
   double best_residual = res.last_change;
   // In the scaled variables the diagonal of D^-1 A is about 1: L starts there and adapts.
   double L = 1.0, theta = 1.0;
-  std::vector<double> history; // residual per iteration
   // the residual rule on the best iterate, which is what is returned
   const auto done = [&] {
     return control.accuracy > 0 ? res.error_estimate() <= control.accuracy
@@ -96,12 +95,7 @@ PgsResult apgd(const ContactSystem &sys, const Exchange &ex, const Cones &cones,
     x = std::move(xn);
     Ax = std::move(Axn);
     L *= 0.9;
-    res.last_change = pr.residual(x, gx);
-    history.push_back(res.last_change);
-    if (history.size() > std::size_t(kRateWindow)) {
-      const double first = history[history.size() - 1 - kRateWindow];
-      res.contraction = first > 0 ? std::pow(res.last_change / first, 1.0 / kRateWindow) : 1.0;
-    }
+    res.record(pr.residual(x, gx));
     if (!std::isfinite(res.last_change)) {
       res.reason = StopReason::non_finite;
       break;

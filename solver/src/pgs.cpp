@@ -10,6 +10,16 @@
 
 namespace fibre {
 
+void PgsResult::record(double change)
+{
+  last_change = change;
+  changes.push_back(change);
+  if (changes.size() > std::size_t(kRateWindow)) {
+    const double first = changes[changes.size() - 1 - kRateWindow];
+    contraction = first > 0 ? std::pow(change / first, 1.0 / kRateWindow) : 1.0;
+  }
+}
+
 double PgsResult::error_estimate() const
 {
   if (last_change == 0) return 0;
@@ -83,7 +93,6 @@ PgsResult pgs(const ContactSystem &sys, const Exchange &ex, const Cones &cones, 
   int since_best = 0;
   Vector direction, change; // nonlinear CG
   double last_change2 = 0;
-  std::vector<double> changes; // relative change per sweep
   std::unique_ptr<FibreBlocks> blocks;
   if (control.fibre_blocks) {
     Vector normal(nc);
@@ -113,12 +122,7 @@ PgsResult pgs(const ContactSystem &sys, const Exchange &ex, const Cones &cones, 
       res.reason = StopReason::non_finite;
       return res;
     }
-    res.last_change = norms[1] > 0 ? std::sqrt(norms[0] / norms[1]) : 0.0;
-    changes.push_back(res.last_change);
-    if (changes.size() > std::size_t(kRateWindow)) {
-      const double first = changes[changes.size() - 1 - kRateWindow];
-      res.contraction = first > 0 ? std::pow(res.last_change / first, 1.0 / kRateWindow) : 1.0;
-    }
+    res.record(norms[1] > 0 ? std::sqrt(norms[0] / norms[1]) : 0.0);
     res.reason = StopReason::max_iterations;
     const bool done = control.accuracy > 0 ? res.error_estimate() <= control.accuracy
                                            : !(norms[0] > control.tol * control.tol * norms[1]);

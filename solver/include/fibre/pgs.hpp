@@ -43,6 +43,9 @@ struct PgsResult {
   // is about last_change * contraction / (1 - contraction): infinite while the changes do not
   // fall.
   double contraction = 1;
+  std::vector<double> changes; // per sweep (iteration)
+  // One more sweep's change: last_change, changes and contraction follow.
+  void record(double change);
   double error_estimate() const;
   bool converged() const { return reason == StopReason::converged; }
 };
