@@ -19,13 +19,7 @@ import subprocess
 
 import fibre_e2e as e2e
 
-DECK = """atom_style sphere
-atom_modify map array
-boundary p p f
-newton off
-comm_modify vel yes
-region box block 0 3 0 3 0 6 units box
-create_box 1 box
+DECK = "\n".join(e2e.sphere_box("0 3 0 3 0 6", boundary="p p f")) + """
 lattice sc 1.0 origin 0.5 0.5 0.5
 region pile block 0 3 0 3 0 2 units box
 create_atoms 1 region pile
