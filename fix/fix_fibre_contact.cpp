@@ -231,10 +231,12 @@ void FixFibreContact::check_pair_style(bool at_init)
 
 // The friction and restitution coefficients per type pair from the pair style (coefficients
 // pair): logged with what the fix does not use; without usable ones, the keywords' values.
+// Untyped, the compliance is the material's where the pair style is one.
 void FixFibreContact::read_coefficients()
 {
   fibre::ContactModel &model = settings_.model;
   model.materials = fibre::MaterialTable();
+  if (!model.typed.compliance) model.compliance.material = false;
   if (model.coefficients != fibre::CoefficientSource::pair) return;
   const fibre_lmp::PairReading reading = fibre_lmp::read_pair_coefficients(lmp);
   if (!reading.failure.empty() && reading.required)
@@ -251,6 +253,7 @@ void FixFibreContact::read_coefficients()
     return;
   }
   model.materials = reading.table;
+  if (!model.typed.compliance) model.compliance.material = reading.material;
   if (comm->me != 0) return;
   bool frictionless = !model.typed.mu;
   for (int i = 1; i <= reading.table.ntypes(); ++i)

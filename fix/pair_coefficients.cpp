@@ -120,10 +120,12 @@ void read_granular(const std::string &bytes, int ntypes, PairReading &out)
     return;
   }
   out.notes.push_back("the stiffnesses of pair_coeff (normal, tangential, rolling and twisting "
-                      "sds) set the rows' compliance with 'compliance material' only; the "
-                      "damping coefficients are not used (SPOOK's damping, and e for bounces)");
+                      "sds) set the rows' compliance ('compliance material', the default here; "
+                      "'compliance auto' makes the rows rigid); the damping coefficients are not "
+                      "used (SPOOK's damping, and e for bounces)");
   if (cohesion) out.notes.push_back("the cohesion of dmt and jkr is not modelled");
   out.table = std::move(table);
+  out.material = true;
 }
 
 // gran/hooke, gran/hooke/history, gran/hertz/history: kn kt gamman gammat xmu (doubles),
@@ -157,8 +159,9 @@ void read_gran(const std::string &style, const std::string &bytes, int ntypes, P
     }
   out.notes.push_back("pair style " + style + ": mu = xmu " + fibre::format_g(xmu) + "; kn " +
                       fibre::format_g(kn) + ", kt " + fibre::format_g(kt) +
-                      " are used by 'compliance material' only (else rigid rows), and its "
-                      "damping gamman " +
+                      " are used by 'compliance material' only (the default here is 'compliance "
+                      "auto', rigid rows: kn = 1 is the common neighbour-list-only setting), and "
+                      "its damping gamman " +
                       fibre::format_g(gamman) +
                       " is viscous, without a single coefficient of restitution: the contacts "
                       "are plastic unless the fix's restitution keyword is given");

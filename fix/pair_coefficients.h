@@ -25,6 +25,10 @@ struct PairReading {
   std::vector<std::string> notes; // what the fix does not use, one line each
   std::string failure;            // why nothing could be read ("" if it could)
   bool required = false; // the host defines its material here (LIGGGHTS): a failure is an error
+  // The style's stiffnesses describe a material, so that 'compliance material' is the default:
+  // pair granular and LIGGGHTS's material properties, not the gran/* styles, whose kn = 1 is
+  // the common neighbour-list-only setting.
+  bool material = false;
 };
 
 PairReading read_pair_coefficients(LAMMPS_NS::LAMMPS *lmp);

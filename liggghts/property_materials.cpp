@@ -121,6 +121,7 @@ PairReading read_pair_coefficients(LAMMPS_NS::LAMMPS *lmp)
       }
     }
   out.table = std::move(table);
+  out.material = hertz && young && poisson;
   return out;
 }
 

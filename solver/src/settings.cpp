@@ -170,6 +170,7 @@ std::size_t read_model_keyword(const Reader &in, std::size_t i, Settings &s)
     const std::string e =
         "'compliance auto|material' or 'compliance <eps_n> <eps_t>' (positive numbers)";
     if (!in.has(i + 1)) Reader::illegal(e);
+    s.model.typed.compliance = true;
     if (in.at(i + 1) == "auto" || in.at(i + 1) == "material") {
       s.model.compliance.automatic = true;
       s.model.compliance.material = in.at(i + 1) == "material";
@@ -292,7 +293,8 @@ std::string describe(const Settings &s)
   std::string out = describe(s.step) + ", rows " + std::to_string(s.model.rows) + ", damping " +
                     format_g(s.model.damping) + ", compliance ";
   if (c.material)
-    out += "material (pair style, else " + format_g(c.factor) + " dt^2 / m_min)";
+    out += std::string("material (pair style, else ") + format_g(c.factor) + " dt^2 / m_min" +
+           (s.model.typed.compliance ? ")" : "; the pair style is a material)");
   else if (c.automatic)
     out += "auto (" + format_g(c.factor) + " dt^2 / m_min)";
   else

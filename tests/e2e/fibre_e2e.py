@@ -146,3 +146,22 @@ def rel_err(a, b):
 
 def finite(values):
     return all(math.isfinite(v) for v in values)
+
+
+def deepest_overlap(frames, floor_z=None):
+    """The deepest sphere-sphere overlap r_i + r_j - |x_i - x_j| over dump frames with x, y,
+    z and radius columns, and with floor_z the deepest r - (z - floor_z): how the tests bound
+    the fix's overlaps by the native twin's."""
+    worst = 0.0
+    for frame in frames:
+        atoms = list(dump_by_id(frame).values())
+        xs = [(a["x"], a["y"], a["z"], a["radius"]) for a in atoms]
+        for i, (xi, yi, zi, ri) in enumerate(xs):
+            if floor_z is not None:
+                worst = max(worst, ri - (zi - floor_z))
+            for xj, yj, zj, rj in xs[i + 1:]:
+                reach = ri + rj
+                dx, dy, dz = xi - xj, yi - yj, zi - zj
+                if abs(dx) < reach and abs(dy) < reach and abs(dz) < reach:
+                    worst = max(worst, reach - math.sqrt(dx * dx + dy * dy + dz * dz))
+    return worst

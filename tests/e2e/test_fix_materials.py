@@ -12,7 +12,9 @@
 - coefficients fix: the pair style is ignored and the fix's defaults hold (mu 0.5: sticks).
 - compliance material: a resting column of spheres of hertz/material overlaps as Hertz says,
   d = (W / (k_n sqrt(r_eff)))^(2/3) with W the weight above each contact and k_n = 4/3 E_eff:
-  every sphere's height within 1% of the overlaps below it, serial and on two processes.
+  every sphere's height within 1% of the overlaps below it, serial (typed) and on two
+  processes (untyped: the default with pair_style granular, and the log says so); with
+  gran/hooke/history the default is compliance auto (rigid rows).
 """
 
 import math
@@ -92,13 +94,13 @@ def drop(args, ck):
                  "%s: type %d (e %g from pair_coeff) rebounds to e^2 h" % (tag, k, e))
 
 
-def hertz_column(args, ck, np):
+def hertz_column(args, ck, np, fix_extra):
     E, nu, n = 2e4, 0.3, 5
     k_n = 4.0 / 3.0 * E / (2 * (1 - nu * nu))
     atoms = [(1, 0.0, 0.5 + k) for k in range(n)]
     pair = ("pair_style granular\npair_coeff * * hertz/material %g 0.5 %g tangential mindlin "
             "NULL 1.0 0.5 damping tsuji" % (E, nu))
-    lines = deck(pair, "0 0 -1", atoms, "compliance material", np, 3000).splitlines()
+    lines = deck(pair, "0 0 -1", atoms, fix_extra, np, 3000).splitlines()
     lines = [ln.replace("thermo 1", "thermo 100") for ln in lines]
     lines.insert(-1, "dump a all custom 3000 hertz_np%d.atoms id z mass" % np)
     lines.insert(-1, "dump_modify a sort id format float %.17g")
@@ -117,6 +119,9 @@ def hertz_column(args, ck, np):
         worst = max(worst, abs(atoms[i]["z"] - z_expected) / overlap)
     ck.check(worst < 0.01, "%s: Hertz overlaps at rest (largest error per overlap)" % tag,
              "%.3g of an overlap" % worst)
+    if not fix_extra:
+        ck.check("compliance material (pair style, else 0.01 dt^2 / m_min; the pair style is a "
+                 "material)" in run.output, "%s: the log names the default compliance" % tag)
 
 
 def main():
@@ -137,10 +142,12 @@ def main():
         ck.check("mu = xmu 0.2" in run.output and
                  "used by 'compliance material' only" in run.output,
                  "incline_gran_hooke: the log says xmu is used and the springs are not")
+        ck.check(", compliance auto (0.01 dt^2 / m_min)," in run.output,
+                 "incline_gran_hooke: the default compliance of gran/* is auto")
     incline(args, ck, "incline_coefficients_fix", GRANULAR, "coefficients fix mu_roll 1.0",
             [(False, 0.5), (False, 0.5)])
-    for np in (1, 2):
-        hertz_column(args, ck, np)
+    hertz_column(args, ck, 1, "compliance material")
+    hertz_column(args, ck, 2, "")
     ck.close()
 
 

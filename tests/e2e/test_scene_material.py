@@ -3,8 +3,10 @@
 Runs examples/material/in.material (fix fibre_contact) with N = 350 for 2.5 simulated
 seconds and the native twin in.material.native (lmp_fibre is a drop-in lmp) for the same
 time. Checks: the emitter inserts its batches of 81 spheres (3 batches by t = 2.5 s), all
-thermo values finite, no sphere lost, the deepest overlap (f_fc[7]) below 2% of the smallest
-diameter, the complementarity residual of every sampled step (f_fc[13]) below 1e-2, the
+thermo values finite, no sphere lost, the deepest overlap (f_fc[7], every thermo line) at most
+1.5 times the native twin's deepest overlap in its snapshots (the deck's pair_coeff is the
+material of both: soft Hertz, E = 1e5, overlaps of several % of a diameter), the
+complementarity residual of every sampled step (f_fc[13]) below 1e-2, the
 spheres reach the plane (lowest sphere top below 1.5), and fibre_contact and
 the native twin agree on the mass-weighted mean height of the spheres within 10%.
 Then a short run (0.3 s) serial and on two processes (np 2 is slow on an oversubscribed
@@ -34,7 +36,7 @@ def main():
     args = e2e.parse_args()
     ck = e2e.Checks("scene: material, N %d, %.1f s" % (N, TEND))
     e2e.copy_scene(args.source, "material", args.workdir)
-    heights = {}
+    heights, worst = {}, {}
     for tag, np_, name in (("serial", 1, "in.material"), ("native", 1, "in.material.native")):
         run = e2e.run_lmp(args, deck(args, name), "material_" + tag, np=np_,
                           variables={"N": N, "tend": TEND})
@@ -49,9 +51,7 @@ def main():
                  % (tag, PER_BATCH * BATCHES), "%g atoms" % atoms)
         ck.check(all(e2e.finite(list(r.values())) for r in rows), "%s: thermo finite" % tag)
         if "f_fc[7]" in rows[-1]:
-            worst = max(r["f_fc[7]"] for r in rows)
-            ck.check(worst < 0.02 * 0.5, "%s: deepest overlap below 2%% of d_min" % tag,
-                     "max f_fc[7] = %.3g" % worst)
+            worst[tag] = max(r["f_fc[7]"] for r in rows)
             # Every step solved: the sweeps stop at sweep_tol 1e-3 (measured: at most 3e-3 on
             # 902 steps of N 1400; 0.09 before the sweeps, whose piles crept).
             compl = max(r["f_fc[13]"] for r in rows)
@@ -66,6 +66,13 @@ def main():
         # the two fibre runs write the same dump name: keep the serial one apart
         os.replace(os.path.join(args.workdir, "pile.%s.%d.dump" % (method, N)),
                    os.path.join(args.workdir, "pile.%s.%d.%s.dump" % (method, N, tag)))
+    if "serial" in worst and "native" in heights:
+        native = e2e.deepest_overlap(
+            e2e.parse_dump(os.path.join(args.workdir, "pile.native.%d.traj" % N)) +
+            e2e.parse_dump(os.path.join(args.workdir, "pile.native.%d.native.dump" % N)), 0.0)
+        ck.check(0 < worst["serial"] <= 1.5 * native,
+                 "serial: deepest overlap at most 1.5x the native twin's",
+                 "max f_fc[7] = %.3g, native %.3g" % (worst["serial"], native))
     ke = {}
     for tag, np_ in (("short_serial", 1), ("short_np2", 2)):
         run = e2e.run_lmp(args, deck(args, "in.material"), "material_" + tag, np=np_,

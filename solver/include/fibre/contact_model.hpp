@@ -15,7 +15,8 @@ namespace fibre {
 // fixed: eps_n on the normal row, eps_t on the tangential rows. The rotational rows take
 // eps_t / r_eff^2 in both modes.
 // material: from the pair style's elastic laws where it has them (material_compliance()),
-// else automatic.
+// else automatic. Untyped, the front end chooses material when its pair style is a material
+// (PairReading::material), else automatic.
 struct ComplianceParams {
   bool automatic = true;
   bool material = false;
@@ -32,7 +33,7 @@ template <> struct EnumNames<CoefficientSource> {
                                                           {CoefficientSource::fix, "fix"}};
 };
 struct TypedCoefficients {
-  bool mu = false, mu_roll = false, mu_twist = false, restitution = false;
+  bool mu = false, mu_roll = false, mu_twist = false, restitution = false, compliance = false;
 };
 
 // The model of one simulation: rows per contact, SPOOK damping, compliance and friction.
