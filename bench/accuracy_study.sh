@@ -1,16 +1,19 @@
 #!/bin/bash
 # Accuracy against cost of the nonsmooth step: every state (a .sys/.lambda pair that
 # bench/export_states.sh or `fix fibre_contact export` wrote) is replayed by fibre_accuracy
-# with six families of settings, each against the state's converged reference (projected
+# with eight families of settings, each against the state's converged reference (projected
 # Gauss-Seidel and semismooth Newton to a complementarity residual of 1e-10, cross-checked):
 #   pgs        solver pgs, S sweeps
 #   nncg       solver nncg (the sweeps with nonsmooth nonlinear CG), S sweeps
 #   fbgs       solver fbgs (the sweeps with fibre-block corrections), S sweeps
 #   apgd       solver apgd (accelerated projected gradient), S iterations
-#   default    the default linear pass (body form, tree-preconditioned CG) then S sweeps
-#   default+cg the same with the sweeps accelerated (sweep_cg yes)
-# for S in the list below (the default families without the rescue, which a sweep_tol of
-# 1e-14 would set off on every step). One CSV per state in the work directory, then
+#   cg         the linear pass (body form, tree-preconditioned CG) then S sweeps (the default
+#              until session 11)
+#   cg+nncg    the same with the sweeps accelerated (sweep_cg yes)
+#   pgs-tol    solver pgs stopped at its accuracy estimate A (tol A; the default is tol 1e-3)
+#   cg-tol     solver cg stopped the same way
+# for S and A in the lists below (tol none, and the cg families without the rescue, which a
+# sweep_tol of 1e-14 would set off on every step). One CSV per state in the work directory, then
 # bench/plot_accuracy.py draws the curves (velocity error against K-product equivalents) and
 # prints the table of bench/README.md.
 #
@@ -37,14 +40,18 @@ done
 mkdir -p "$work"
 settings=()
 for s in 5 10 20 50 100 200 500 1000; do
-  settings+=(--setting "solver pgs sweeps $s sweep_tol 1e-14")
-  settings+=(--setting "solver nncg sweeps $s sweep_tol 1e-14")
-  settings+=(--setting "solver fbgs sweeps $s sweep_tol 1e-14")
-  settings+=(--setting "solver apgd sweeps $s sweep_tol 1e-14")
+  settings+=(--setting "solver pgs tol none sweeps $s sweep_tol 1e-14")
+  settings+=(--setting "solver nncg tol none sweeps $s sweep_tol 1e-14")
+  settings+=(--setting "solver fbgs tol none sweeps $s sweep_tol 1e-14")
+  settings+=(--setting "solver apgd tol none sweeps $s sweep_tol 1e-14")
 done
 for s in 0 5 10 20 50 100 200 500; do
-  settings+=(--setting "sweeps $s sweep_tol 1e-14 rescue_sweeps 0")
-  settings+=(--setting "sweep_cg yes sweeps $s sweep_tol 1e-14 rescue_sweeps 0")
+  settings+=(--setting "solver cg tol none sweeps $s sweep_tol 1e-14 rescue_sweeps 0")
+  settings+=(--setting "solver cg tol none sweep_cg yes sweeps $s sweep_tol 1e-14 rescue_sweeps 0")
+done
+for a in 1e-2 3e-3 1e-3 3e-4 1e-4; do
+  settings+=(--setting "solver pgs tol $a")
+  settings+=(--setting "solver cg tol $a")
 done
 settings+=(--setting "")
 for sys in "$states"/*.sys; do

@@ -3,7 +3,8 @@
 
 One panel per state: the velocity-change error (the larger of the translational and the
 rotational relative errors) against the cost in K-product equivalents, one curve per family
-(pgs, nncg, fbgs, apgd, default, default+cg), the defaults marked. Prints, per state and family, the
+(pgs, nncg, fbgs, apgd, cg, cg+nncg, pgs-tol, cg-tol), the defaults marked. Prints, per state and
+family, the
 cheapest setting that reaches 1e-3 in velocity and 1e-2 in impulses, as bench/README.md shows.
 """
 
@@ -12,11 +13,13 @@ import csv
 import math
 import os
 
-FAMILIES = ["pgs", "nncg", "fbgs", "apgd", "default", "default+cg"]
+FAMILIES = ["pgs", "nncg", "fbgs", "apgd", "cg", "cg+nncg", "pgs-tol", "cg-tol"]
 DEFAULT = "(defaults)"  # fibre_accuracy's name of the empty setting
 
 
 def family(setting):
+    if "tol none" not in setting and setting != DEFAULT:
+        return "pgs-tol" if "solver pgs" in setting else "cg-tol"
     if "solver pgs" in setting:
         return "pgs"
     if "solver nncg" in setting:
@@ -26,8 +29,8 @@ def family(setting):
     if "solver apgd" in setting:
         return "apgd"
     if "sweep_cg yes" in setting:
-        return "default+cg"
-    return "default"
+        return "cg+nncg"
+    return "cg"
 
 
 def read(path):
@@ -59,7 +62,7 @@ def main():
             ok = [r for r in rows if r["family"] == fam and r["setting"] != DEFAULT
                   and r["velocity"] <= 1e-3 and r["impulse"] <= 1e-2]
             best = min(ok, key=lambda r: r["k_products"]) if ok else None
-            d = default[0] if default and fam == "default" else None
+            d = default[0] if default and fam == "pgs-tol" else None
             print("| %s | %s | %s | %s | %s |" % (
                 name, fam,
                 "%.0f (%s)" % (best["k_products"], best["setting"]) if best else "not reached",
@@ -75,7 +78,8 @@ def main():
     cols = min(4, len(states))
     rows_n = math.ceil(len(states) / cols)
     fig, axes = plt.subplots(rows_n, cols, figsize=(4.2 * cols, 3.6 * rows_n), squeeze=False)
-    styles = {"pgs": "o-", "nncg": "s-", "fbgs": "d-", "apgd": "x-", "default": "^-", "default+cg": "v-"}
+    styles = {"pgs": "o-", "nncg": "s-", "fbgs": "d-", "apgd": "x-", "cg": "^-", "cg+nncg": "v-",
+              "pgs-tol": "P-", "cg-tol": "X-"}
     for ax, (name, rows) in zip(axes.flat, states):
         for fam in FAMILIES:
             pts = sorted((r["k_products"], r["velocity"]) for r in rows

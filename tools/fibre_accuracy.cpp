@@ -48,15 +48,17 @@ options:
 
 const std::vector<std::string> kGrid = {
     "",
-    "sweeps 0",
-    "sweeps 200 sweep_tol 1e-4",
-    "sweeps 1000 sweep_tol 1e-6",
-    "active_set 10 sweeps 0",
-    "linear_tol 1e-8 active_set 10 sweeps 200 sweep_tol 1e-4",
-    "solver pgs sweeps 50 sweep_tol 1e-12",
-    "solver pgs sweeps 200 sweep_tol 1e-12",
-    "solver pgs sweeps 500 sweep_tol 1e-12",
-    "solver pgs sweeps 2000 sweep_tol 1e-12",
+    "tol 1e-2",
+    "tol 1e-4",
+    "solver cg tol none",
+    "solver cg tol 1e-3",
+    "solver cg tol none sweeps 0",
+    "solver cg tol none sweeps 200 sweep_tol 1e-4",
+    "solver cg tol none active_set 10 sweeps 0",
+    "solver cg tol none linear_tol 1e-8 active_set 10 sweeps 200 sweep_tol 1e-4",
+    "solver pgs tol none sweeps 50 sweep_tol 1e-12",
+    "solver pgs tol none sweeps 500 sweep_tol 1e-12",
+    "solver pgs tol none sweeps 2000 sweep_tol 1e-12",
 };
 
 struct Options {

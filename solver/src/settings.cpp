@@ -279,8 +279,8 @@ Settings parse_settings(const std::vector<std::string> &args)
           &key);
     i += used;
   }
-  // a step accuracy needs room to reach it
-  if (s.step.accuracy > 0 && !sweeps_typed) s.step.sweeps = kAccuracySweeps;
+  // a step accuracy needs room to reach it; a fast step (tol none) stops at its cap
+  if (!sweeps_typed) s.step.sweeps = s.step.accuracy > 0 ? kAccuracySweeps : kFastSweeps;
   const FrictionParams &f = s.model.friction;
   if (s.model.rows == 3 && (f.mu_roll > 0.0 || f.mu_twist > 0.0))
     throw SettingsError("mu_roll and mu_twist need 'rows 6' (rows 3 has no rotational rows)");

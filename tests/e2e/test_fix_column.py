@@ -9,7 +9,8 @@ for 1000 steps with every solver and both forms. Checks:
   contact form (body form: 5e-7, MUMPS: 1e-12), final kinetic energy below 1e-10 (MUMPS:
   1e-20);
 - the normal impulse of every contact equals dt * g * (mass above it): relative error below
-  1e-9 with MUMPS, 1e-5 in contact form and 1e-3 in body form at linear_tol 1e-6 (read
+  1e-9 with MUMPS, 1e-5 in contact form and 1e-3 in body form at linear_tol 1e-6, 2e-3 with
+  the default (projected Gauss-Seidel to tol 1e-3) (read
   from the fix's per-contact local output through dump local);
 - the fix's global vector: 6 contacts, 1 wall contact, converged, and the deepest overlap
   (f_fc[7]) equals eps_n times the column's weight;
@@ -72,8 +73,12 @@ def main():
         ("minres_body", "form body solver minres linear_tol 1e-6", 1e-3, 1e-10, 5e-7),
         ("uzawa_contact", "form contact solver uzawa linear_tol 1e-6", 1e-5, 1e-10, 1e-9),
         ("direct", "solver direct export 500 col_export", 1e-9, 1e-20, 1e-12),
-        ("fibre_rows3", "form body precond fibre rows 3 linear_tol 1e-6", 1e-3, 1e-10, 5e-7),
-        ("tree_contact", "form contact precond tree linear_tol 1e-6", 1e-5, 1e-10, 1e-9),
+        ("fibre_rows3", "solver cg tol none form body precond fibre rows 3 linear_tol 1e-6", 1e-3,
+         1e-10, 5e-7),
+        ("tree_contact", "solver cg tol none form contact precond tree linear_tol 1e-6", 1e-5,
+         1e-10, 1e-9),
+        # the default step: projected Gauss-Seidel to tol 1e-3
+        ("default", "", 2e-3, 1e-10, 5e-7),
     ]
     eps = 1e-2 * DT ** 2 / min(masses)
     carried = [GRAVITY * sum(masses[i:]) for i in range(len(masses))]  # by the contact below i

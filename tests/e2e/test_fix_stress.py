@@ -38,7 +38,8 @@ def deck(np):
         "neighbor 0.2 bin",
         "timestep %g" % DT,
         "fix g all gravity %g vector 0 0 -1" % G,
-        "fix fc all fibre_contact wall zplane 0.0 NULL linear_tol 1e-10 sweep_tol 1e-10 sweeps 200",
+        "fix fc all fibre_contact wall zplane 0.0 NULL solver cg tol none linear_tol 1e-10 "
+        "sweep_tol 1e-10 sweeps 200",
         "compute sa all stress/atom NULL virial",
         "compute s all reduce sum c_sa[1] c_sa[2] c_sa[3] c_sa[4] c_sa[5] c_sa[6]",
         "compute p all pressure NULL virial",

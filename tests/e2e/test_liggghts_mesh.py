@@ -217,7 +217,8 @@ def pile_deck(np_grid=None):
              "timestep 0.0005",
              "fix g all gravity 9.81 vector 0 0 -1",
              "fix box all mesh/surface file box.stl type 2",
-             "fix fc all fibre_contact wall mesh box linear_tol 1e-8 sweeps 400 sweep_tol 1e-8",
+             "fix fc all fibre_contact wall mesh box solver cg tol none linear_tol 1e-8 sweeps 400 "
+             "sweep_tol 1e-8",
              "compute c all com",
              "thermo_style custom step atoms ke c_c[1] c_c[2] c_c[3] f_fc[3]",
              "thermo_modify format float %.15g", "thermo 100"]
@@ -252,7 +253,8 @@ def parallel_and_restart(args, checks):
         if ln.startswith("fix m") or ln.startswith("pair_")] + [
         "fix g all gravity 9.81 vector 0 0 -1",
         "fix box all mesh/surface file box.stl type 2",
-        "fix fc all fibre_contact wall mesh box linear_tol 1e-8 sweeps 400 sweep_tol 1e-8",
+        "fix fc all fibre_contact wall mesh box solver cg tol none linear_tol 1e-8 sweeps 400 "
+        "sweep_tol 1e-8",
         "timestep 0.0005", "compute c all com",
         "thermo_style custom step atoms ke c_c[1] c_c[2] c_c[3] f_fc[3]",
         "thermo_modify format float %.15g", "thermo 100", "run 100"]

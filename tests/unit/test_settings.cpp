@@ -37,18 +37,18 @@ TEST(Settings, NoKeywordsKeepTheDefaults)
   const Settings s = parse_settings({});
   const StepOptions d{};
   EXPECT_EQ(describe(s.step), describe(d));
-  // the measured defaults (doc/design.md section 4)
+  // the measured defaults (doc/design.md section 4; bench/README.md section 7)
   EXPECT_EQ(d.form, Form::body);
-  EXPECT_EQ(d.solver, Method::cg);
+  EXPECT_EQ(d.solver, Method::pgs);
   EXPECT_EQ(d.precond.kind, PrecondKind::tree);
   EXPECT_EQ(d.precond.weight, EdgeWeight::z);
   EXPECT_DOUBLE_EQ(d.stop.tol, 1e-4);
   EXPECT_EQ(d.stop.max_iter, 200);
   EXPECT_DOUBLE_EQ(d.pass_tol, 1e-3);
   EXPECT_EQ(d.active_set_max, 1);
-  EXPECT_EQ(d.sweeps, 50);
+  EXPECT_EQ(d.sweeps, kAccuracySweeps);
   EXPECT_DOUBLE_EQ(d.sweep_tol, 1e-3);
-  EXPECT_DOUBLE_EQ(d.accuracy, 0.0); // tol none
+  EXPECT_DOUBLE_EQ(d.accuracy, 1e-3); // the step's accuracy
   EXPECT_DOUBLE_EQ(s.model.friction.mu, 0.5);
   EXPECT_EQ(s.model.rows, 6);
   EXPECT_DOUBLE_EQ(s.model.damping, 2.0);
@@ -57,8 +57,8 @@ TEST(Settings, NoKeywordsKeepTheDefaults)
   EXPECT_TRUE(s.walls.empty());
   EXPECT_EQ(s.export_every, 0);
   EXPECT_EQ(describe(s),
-            "form body, solver cg, precond tree, weight z, tol none, linear_tol 0.0001, pass_tol "
-            "0.001, maxiter 200, active_set 1, sweeps 50, sweep_tol 0.001, rescue_sweeps 500, rows "
+            "form body, solver pgs, precond tree, weight z, tol 0.001, linear_tol 0.0001, pass_tol "
+            "0.001, maxiter 200, active_set 1, sweeps 2000, sweep_tol 0.001, rescue_sweeps 500, rows "
             "6, damping 2, "
             "compliance auto "
             "(0.01 dt^2 / m_min), recovery_speed auto (0.01 r_min / dt), restitution 0, "
@@ -152,7 +152,8 @@ TEST(Settings, TolIsTheStepAccuracyAndRaisesTheSweepCap)
   EXPECT_DOUBLE_EQ(parse_settings(words("tol 1e-3")).step.accuracy, 1e-3);
   EXPECT_EQ(parse_settings(words("sweeps 300 tol 1e-3")).step.sweeps, 300);
   EXPECT_EQ(parse_settings(words("tol 1e-3 sweeps 300")).step.sweeps, 300);
-  EXPECT_EQ(parse_settings(words("tol none")).step.sweeps, StepOptions{}.sweeps);
+  EXPECT_EQ(parse_settings(words("tol none")).step.sweeps, kFastSweeps);
+  EXPECT_EQ(parse_settings(words("tol none sweeps 80")).step.sweeps, 80);
   EXPECT_DOUBLE_EQ(parse_settings(words("tol 1e-3 tol none")).step.accuracy, 0.0);
 }
 

@@ -58,6 +58,9 @@ StepOptions base_options()
   o.stop.max_iter = 500;
   o.active_set_max = 5;
   o.pass_tol = 1e-4;
+  // the linear pass's machinery, finished as a fast step (tol none)
+  o.accuracy = 0;
+  o.sweeps = kFastSweeps;
   return o;
 }
 
