@@ -33,7 +33,10 @@ StepOptions sweeps_only(Method m, int sweeps)
 
 // The defaults before session 11, with which the shipped state was exported: the tree-CG pass
 // and at most 50 sweeps, no step accuracy.
-StepOptions former_default() { return parse_settings({"solver", "cg", "tol", "none"}).step; }
+StepOptions former_default()
+{
+  return parse_settings({"solver", "cg", "tol", "none"}).step;
+}
 
 } // namespace
 
