@@ -56,15 +56,16 @@ TEST(Settings, NoKeywordsKeepTheDefaults)
   EXPECT_DOUBLE_EQ(s.model.compliance.factor, 1e-2);
   EXPECT_TRUE(s.walls.empty());
   EXPECT_EQ(s.export_every, 0);
-  EXPECT_EQ(describe(s),
-            "form body, solver pgs, precond tree, weight z, tol 0.001, linear_tol 0.0001, pass_tol "
-            "0.001, maxiter 200, active_set 1, sweeps 2000, sweep_tol 0.001, rescue_sweeps 500, rows "
-            "6, damping 2, "
-            "compliance auto "
-            "(0.01 dt^2 / m_min), recovery_speed auto (0.01 r_min / dt), restitution 0, "
-            "bounce_speed auto (2 dt |f| / m max, or 0.01 r_min / dt without forces), coefficients "
-            "pair, mu 0.5, mu_roll 0, "
-            "mu_twist 0");
+  EXPECT_EQ(
+      describe(s),
+      "form body, solver pgs, precond tree, weight z, tol 0.001, linear_tol 0.0001, pass_tol "
+      "0.001, maxiter 200, active_set 1, sweeps 2000, sweep_tol 0.001, rescue_sweeps 500, rows "
+      "6, damping 2, "
+      "compliance auto "
+      "(0.01 dt^2 / m_min), recovery_speed auto (0.01 r_min / dt), restitution 0, "
+      "bounce_speed auto (2 dt |f| / m max, or 0.01 r_min / dt without forces), coefficients "
+      "pair, mu 0.5, mu_roll 0, "
+      "mu_twist 0");
 }
 
 TEST(Settings, EveryKeywordSetsWhatItNames)
