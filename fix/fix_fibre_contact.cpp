@@ -17,6 +17,9 @@
 #include <limits>
 #include <string>
 #include <vector>
+#if defined(__GLIBC__)
+#include <malloc.h>
+#endif
 
 #include "atom.h"
 #include "comm.h"
@@ -48,8 +51,25 @@ using fibre_lmp::warn;
 
 /* ---------------------------------------------------------------------- */
 
+namespace {
+
+// Each step allocates and frees its buffers (impulses, rows, residuals: hundreds of kB to a few
+// MB). With glibc's defaults the freed memory went back to the system and every step faulted
+// it in again: 40% of the material deck's time (bench/README.md section 4). Freed memory up to
+// 256 MB stays with the process, and blocks below 64 MB come from the heap.
+void keep_step_memory()
+{
+#if defined(__GLIBC__)
+  mallopt(M_MMAP_THRESHOLD, 64 << 20);
+  mallopt(M_TRIM_THRESHOLD, 256 << 20);
+#endif
+}
+
+} // namespace
+
 FixFibreContact::FixFibreContact(LAMMPS *lmp, int narg, char **arg) : Fix(lmp, narg, arg)
 {
+  keep_step_memory();
   if (!atom->radius_flag || !atom->rmass_flag || !atom->omega_flag || !atom->torque_flag)
     fail(error, FLERR,
          "Fix fibre_contact requires atom attributes radius, rmass, "
