@@ -3,6 +3,7 @@
 #include <cmath>
 
 #include <algorithm>
+#include <numeric>
 
 namespace fibre {
 
@@ -70,11 +71,20 @@ int plane_hits(const WallSpec &wall, const Body &b, double reach, PlaneHit hits[
 
 void sort_contacts(std::vector<DetectedContact> &found)
 {
-  std::sort(found.begin(), found.end(), [](const DetectedContact &p, const DetectedContact &q) {
+  // sort the keys, then move each contact once: a Contact is a few hundred bytes, and swapping
+  // them in the sort was 4% of a step
+  std::vector<std::size_t> order(found.size());
+  std::iota(order.begin(), order.end(), std::size_t{0});
+  std::sort(order.begin(), order.end(), [&found](std::size_t i, std::size_t j) {
+    const DetectedContact &p = found[i], &q = found[j];
     if (p.tag_a != q.tag_a) return p.tag_a < q.tag_a;
     if (p.partner != q.partner) return p.partner < q.partner;
     return p.contact.gap < q.contact.gap;
   });
+  std::vector<DetectedContact> sorted;
+  sorted.reserve(found.size());
+  for (std::size_t i : order) sorted.push_back(std::move(found[i]));
+  found.swap(sorted);
 }
 
 } // namespace fibre
