@@ -48,7 +48,7 @@ TEST(Settings, NoKeywordsKeepTheDefaults)
   EXPECT_EQ(d.active_set_max, 1);
   EXPECT_EQ(d.sweeps, kAccuracySweeps);
   EXPECT_DOUBLE_EQ(d.sweep_tol, 1e-3);
-  EXPECT_DOUBLE_EQ(d.accuracy, 1e-3); // the step's accuracy
+  EXPECT_DOUBLE_EQ(d.accuracy, 1e-4); // the step's accuracy
   EXPECT_DOUBLE_EQ(s.model.friction.mu, 0.5);
   EXPECT_EQ(s.model.rows, 6);
   EXPECT_DOUBLE_EQ(s.model.damping, 2.0);
@@ -58,7 +58,7 @@ TEST(Settings, NoKeywordsKeepTheDefaults)
   EXPECT_EQ(s.export_every, 0);
   EXPECT_EQ(
       describe(s),
-      "form body, solver pgs, precond tree, weight z, tol 0.001, linear_tol 0.0001, pass_tol "
+      "form body, solver pgs, precond tree, weight z, tol 0.0001, linear_tol 0.0001, pass_tol "
       "0.001, maxiter 200, active_set 1, sweeps 2000, sweep_tol 0.001, rescue_sweeps 500, rows "
       "6, damping 2, "
       "compliance auto "

@@ -24,8 +24,9 @@ inline constexpr int kFastSweeps = 50;
 // The one home of the step's defaults, measured on the material and silo scenes
 // (doc/design.md section 8, bench/README.md section 7, doc/fix_fibre_contact.md "Solvers").
 // Front ends override only what the user typed. The default step is projected Gauss-Seidel to
-// an accuracy of 1e-3: warm-started from the last step's accurate impulses it was the
-// cheapest way to that accuracy, and cheaper end to end than the linear pass with 50 sweeps.
+// an accuracy of 1e-4: warm-started from the last step's accurate impulses it was the
+// cheapest way to a velocity error of 1e-3, about as fast end to end as the linear pass with
+// 50 sweeps, and at 1e-3 the sweeps held an arch that clogged a silo (bench/README.md).
 struct StepOptions {
   Form form = Form::body;
   Method solver = Method::pgs;
@@ -61,7 +62,7 @@ struct StepOptions {
   // estimate of the impulses' remaining relative error (StepResult::error_estimate) is at most
   // this, after at most `sweeps` sweeps; sweep_tol and the rescue then play no part, and a step
   // that ends above it counts as not converged.
-  double accuracy = 1e-3;
+  double accuracy = 1e-4;
 };
 
 inline constexpr double kRescueFactor = 10.0;
