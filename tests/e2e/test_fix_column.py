@@ -10,7 +10,7 @@ for 1000 steps with every solver and both forms. Checks:
   1e-20);
 - the normal impulse of every contact equals dt * g * (mass above it): relative error below
   1e-9 with MUMPS, 1e-5 in contact form and 1e-3 in body form at linear_tol 1e-6, 2e-3 with
-  the default (projected Gauss-Seidel to tol 1e-3) (read
+  the default (projected Gauss-Seidel to tol 1e-4) (read
   from the fix's per-contact local output through dump local);
 - the fix's global vector: 6 contacts, 1 wall contact, converged, and the deepest overlap
   (f_fc[7]) equals eps_n times the column's weight;
@@ -77,7 +77,7 @@ def main():
          1e-10, 5e-7),
         ("tree_contact", "solver cg tol none form contact precond tree linear_tol 1e-6", 1e-5,
          1e-10, 1e-9),
-        # the default step: projected Gauss-Seidel to tol 1e-3
+        # the default step: projected Gauss-Seidel to tol 1e-4
         ("default", "", 2e-3, 1e-10, 5e-7),
     ]
     eps = 1e-2 * DT ** 2 / min(masses)
