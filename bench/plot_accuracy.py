@@ -3,7 +3,8 @@
 
 One panel per state: the velocity-change error (the larger of the translational and the
 rotational relative errors) against the cost in K-product equivalents, one curve per family
-(pgs, nncg, fbgs, apgd, cg, cg+nncg, pgs-tol, cg-tol), the defaults marked. Prints, per state and
+(pgs, nncg, fbgs, apgd, cg, cg+nncg, and each solver stopped at its accuracy, pgs-tol ...),
+the defaults marked. Prints, per state and
 family, the
 cheapest setting that reaches 1e-3 in velocity and 1e-2 in impulses, as bench/README.md shows.
 """
@@ -13,13 +14,17 @@ import csv
 import math
 import os
 
-FAMILIES = ["pgs", "nncg", "fbgs", "apgd", "cg", "cg+nncg", "pgs-tol", "cg-tol"]
+FAMILIES = ["pgs", "nncg", "fbgs", "apgd", "cg", "cg+nncg", "pgs-tol", "cg-tol", "nncg-tol",
+            "fbgs-tol", "apgd-tol"]
 DEFAULT = "(defaults)"  # fibre_accuracy's name of the empty setting
 
 
 def family(setting):
     if "tol none" not in setting and setting != DEFAULT:
-        return "pgs-tol" if "solver pgs" in setting else "cg-tol"
+        for solver in ("pgs", "nncg", "fbgs", "apgd"):
+            if "solver " + solver in setting:
+                return solver + "-tol"
+        return "cg-tol"
     if "solver pgs" in setting:
         return "pgs"
     if "solver nncg" in setting:
@@ -59,6 +64,8 @@ def main():
     for name, rows in states:
         default = [r for r in rows if r["setting"] == DEFAULT]
         for fam in FAMILIES:
+            if not any(r["family"] == fam for r in rows):
+                continue  # not in this study's grid
             ok = [r for r in rows if r["family"] == fam and r["setting"] != DEFAULT
                   and r["velocity"] <= 1e-3 and r["impulse"] <= 1e-2]
             best = min(ok, key=lambda r: r["k_products"]) if ok else None
@@ -79,14 +86,14 @@ def main():
     rows_n = math.ceil(len(states) / cols)
     fig, axes = plt.subplots(rows_n, cols, figsize=(4.2 * cols, 3.6 * rows_n), squeeze=False)
     styles = {"pgs": "o-", "nncg": "s-", "fbgs": "d-", "apgd": "x-", "cg": "^-", "cg+nncg": "v-",
-              "pgs-tol": "P-", "cg-tol": "X-"}
+              "pgs-tol": "P-", "cg-tol": "X-", "nncg-tol": "*-", "fbgs-tol": "D-", "apgd-tol": "+-"}
     for ax, (name, rows) in zip(axes.flat, states):
         for fam in FAMILIES:
             pts = sorted((r["k_products"], r["velocity"]) for r in rows
                          if r["family"] == fam and r["setting"] != DEFAULT and r["velocity"] > 0)
             if pts:
                 ax.loglog([x for x, _ in pts], [y for _, y in pts], styles[fam], ms=3, label=fam,
-                          color="C%d" % FAMILIES.index(fam))  # the same colour in every panel
+                          color="C%d" % (FAMILIES.index(fam) % 10))  # one colour a family
         for r in rows:
             if r["setting"] == DEFAULT:
                 ax.loglog([r["k_products"]], [r["velocity"]], "k*", ms=10, label="defaults")
