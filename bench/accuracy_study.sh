@@ -10,7 +10,7 @@
 #   cg         the linear pass (body form, tree-preconditioned CG) then S sweeps (the default
 #              until session 11)
 #   cg+nncg    the same with the sweeps accelerated (sweep_cg yes)
-#   pgs-tol    solver pgs stopped at its accuracy estimate A (tol A; the default is tol 1e-3)
+#   pgs-tol    solver pgs stopped at its accuracy estimate A (tol A; the default is tol 1e-4)
 #   cg-tol     solver cg stopped the same way
 # for S and A in the lists below (tol none, and the cg families without the rescue, which a
 # sweep_tol of 1e-14 would set off on every step). One CSV per state in the work directory, then

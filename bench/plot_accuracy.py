@@ -4,8 +4,7 @@
 One panel per state: the velocity-change error (the larger of the translational and the
 rotational relative errors) against the cost in K-product equivalents, one curve per family
 (pgs, nncg, fbgs, apgd, cg, cg+nncg, and each solver stopped at its accuracy, pgs-tol ...),
-the defaults marked. Prints, per state and
-family, the
+the defaults marked. Prints, per state and family, the
 cheapest setting that reaches 1e-3 in velocity and 1e-2 in impulses, as bench/README.md shows.
 """
 
