@@ -13,7 +13,10 @@
 # those of the decks' full runs. One serial run per scene and N, one at a time.
 #
 # Usage: bench/export_states.sh [--N "1400 5000"] [--lmp build/fix/lmp_fibre]
-#                               [--work /tmp/fibre_states]
+#                               [--work /tmp/fibre_states] [--scenes "material silo"]
+#                               [--var NAME VALUE ...]
+# --var passes a deck variable to every run, for example `--var E 1e8` for the states of a
+# stiff material (the decks' fibre step does not depend on E; bench/README.md section 7).
 # The states go into the work directory, the runs into <work>/run_<scene><N>/ (their logs:
 # <work>/<scene><N>.log, the exports not kept are deleted). <work>/states.txt lists every
 # state in the work directory: step, simulated time, contacts, bodies (owned), and the
@@ -27,17 +30,24 @@ src=$(cd "$(dirname "$0")/.." && pwd)
 Ns="1400 5000"
 lmp=$src/build/fix/lmp_fibre
 work=/tmp/fibre_states
+scenes="material silo"
+vars=() # -var NAME VALUE for every run
 while [ $# -gt 0 ]; do
   case $1 in
     -h|--help) usage "$0"; exit 0 ;;
-    --N|--lmp|--work)
+    --N|--lmp|--work|--scenes)
       [ $# -ge 2 ] || { echo "$(basename "$0"): $1 needs a value" >&2; exit 2; }
       case $1 in
         --N) Ns=$2 ;;
         --lmp) lmp=$2 ;;
         --work) work=$2 ;;
+        --scenes) scenes=$2 ;;
       esac
       shift 2 ;;
+    --var)
+      [ $# -ge 3 ] || { echo "$(basename "$0"): --var needs a name and a value" >&2; exit 2; }
+      vars+=(-var "$2" "$3")
+      shift 3 ;;
     *) echo "$(basename "$0"): unknown option $1 (--help: the usage)" >&2; exit 2 ;;
   esac
 done
@@ -75,7 +85,8 @@ probe() {  # scene N
   else
     echo 'print "probe ${dt} ${nfill} ${nflow}"' >> run.silo
   fi
-  "$lmp" -in "in.$scene" -var N "$n" -echo none -log probe.log -screen none > /dev/null 2>&1 ||
+  "$lmp" -in "in.$scene" -var N "$n" "${vars[@]}" -echo none -log probe.log -screen none \
+    > /dev/null 2>&1 ||
     { echo "probe of $scene $n failed: $dir/probe.log" >&2; exit 1; }
   local line last
   line=$(sed -n 's/^probe //p' probe.log)
@@ -91,9 +102,9 @@ run_scene() {  # scene N name1 step1 name2 step2 every [-var name value ...]
   local dir="$work/run_$scene$n" t0 t1
   rm -rf "$dir" && mkdir -p "$dir" && cd "$dir"
   copy_deck "$scene" "$every"
-  echo "$scene $n: states at steps $s1 ($name1), $s2 ($name2); export every $every, $*"
+  echo "$scene $n: states at steps $s1 ($name1), $s2 ($name2); export every $every, ${vars[*]} $*"
   t0=$(date +%s)
-  "$lmp" -in "in.$scene" -var N "$n" "$@" -var fc_extra "export $every snap" \
+  "$lmp" -in "in.$scene" -var N "$n" "${vars[@]}" "$@" -var fc_extra "export $every snap" \
     -echo none -log log.txt -screen none > out.txt 2>&1 ||
     { echo "$scene $n: run failed, see $dir/log.txt" >&2; exit 1; }
   t1=$(date +%s)
@@ -107,7 +118,7 @@ run_scene() {  # scene N name1 step1 name2 step2 every [-var name value ...]
     mv "snap.$s.0.lambda" "$work/$name.lambda"
   done
   rm -f snap.*.sys snap.*.lambda
-  { echo "# export_states.sh: $scene N $n, wall $((t1 - t0)) s, $(basename "$lmp")," \
+  { echo "# export_states.sh: $scene N $n ${vars[*]}, wall $((t1 - t0)) s, $(basename "$lmp")," \
          "$(git -C "$src" describe --always --dirty 2>/dev/null || echo '?')"
     cat log.txt; } > "$work/$scene$n.log"
   cd "$work"
@@ -117,14 +128,25 @@ run_scene() {  # scene N name1 step1 name2 step2 every [-var name value ...]
 near() { echo $(( ($1 + grid / 2) / grid * grid )); }
 floor() { echo $(( $1 / grid * grid )); }
 
+has_scene() { case " $scenes " in *" $1 "*) return 0 ;; *) return 1 ;; esac; }
+for s in $scenes; do
+  case $s in
+    material|silo) ;;
+    *) echo "$(basename "$0"): unknown scene $s (--scenes: material, silo)" >&2; exit 2 ;;
+  esac
+done
+
 for n in $Ns; do
-  # material: forming at 70% of the pour, settled at the deck's end
-  sched=$(probe material "$n")
-  read -r dt nsteps last <<< "$sched"
-  s1=$(near $((last * 7 / 10)))
-  s2=$(floor "$nsteps")
-  tend=$(awk -v s="$s2" -v dt="$dt" 'BEGIN { printf "%.17g", s * dt }')
-  run_scene material "$n" forming "$s1" settled "$s2" "$(gcd "$s1" "$s2")" -var tend "$tend"
+  if has_scene material; then
+    # material: forming at 70% of the pour, settled at the deck's end
+    sched=$(probe material "$n")
+    read -r dt nsteps last <<< "$sched"
+    s1=$(near $((last * 7 / 10)))
+    s2=$(floor "$nsteps")
+    tend=$(awk -v s="$s2" -v dt="$dt" 'BEGIN { printf "%.17g", s * dt }')
+    run_scene material "$n" forming "$s1" settled "$s2" "$(gcd "$s1" "$s2")" -var tend "$tend"
+  fi
+  has_scene silo || continue
   # silo: filled at the end of the fill, discharge halfway through tflow
   sched=$(probe silo "$n")
   read -r dt nfill nflow <<< "$sched"
