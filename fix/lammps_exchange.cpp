@@ -29,6 +29,7 @@ void LammpsExchange::set_bodies(const std::vector<int> &body_atom, int num_owned
     const auto it = k < num_owned ? owned.end() : owned.find(tag[body_atom[k]]);
     local_owners_[k] = it == owned.end() ? k : it->second;
   }
+  has_halo_ = lmp_->comm->nprocs > 1 || body_atom.size() > std::size_t(num_owned);
 }
 
 void LammpsExchange::resize_halo() const
@@ -39,6 +40,7 @@ void LammpsExchange::resize_halo() const
 
 void LammpsExchange::forward(fibre::Vector &body_vec) const
 {
+  if (!has_halo_) return;
   resize_halo();
   const int nbody = static_cast<int>(body_atom_.size());
   for (int k = 0; k < num_owned_; ++k) {
@@ -54,6 +56,7 @@ void LammpsExchange::forward(fibre::Vector &body_vec) const
 
 void LammpsExchange::reverse_sum(fibre::Vector &body_vec) const
 {
+  if (!has_halo_) return;
   resize_halo();
   const std::size_t nall = std::size_t(lmp_->atom->nlocal + lmp_->atom->nghost);
   std::fill(halo_.begin(), halo_.begin() + kValuesPerAtom * nall, 0.0);

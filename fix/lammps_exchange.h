@@ -33,6 +33,7 @@ class LammpsExchange final : public fibre::Exchange {
 
   void forward(fibre::Vector &body_vec) const override;
   void reverse_sum(fibre::Vector &body_vec) const override;
+  bool has_halo() const override { return has_halo_; }
   void sum(double *values, int n) const override;
   void max(double *values, int n) const override;
   long exclusive_prefix_sum(long local) const override;
@@ -55,6 +56,7 @@ class LammpsExchange final : public fibre::Exchange {
   std::vector<int> body_atom_;
   int num_owned_ = 0;
   std::vector<int> local_owners_;    // periodic images of owned bodies -> those bodies
+  bool has_halo_ = true;             // other processes, or ghost bodies here
   mutable std::vector<double> halo_; // 6 per local atom (owned + ghost)
 };
 

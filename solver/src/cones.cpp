@@ -18,27 +18,6 @@ Cones::Cones(const ContactSystem &sys)
   }
 }
 
-// Hot in the sweeps: squared norms, one square root only for a cone outside.
-void Cones::project(double *l, int c) const
-{
-  l[0] = l[0] > 0 ? l[0] : 0.0; // also NaN -> 0
-  if (!std::isfinite(l[0])) l[0] = 0.0;
-  for (int k = 0; k < num_cones(rows_); ++k) {
-    double *t = l + kCones[k].first;
-    const bool pair = kCones[k].size == 2;
-    const double radius = coeff(c, k) * l[0];
-    const double tn2 = t[0] * t[0] + (pair ? t[1] * t[1] : 0.0);
-    if (!(radius > 0) || !std::isfinite(tn2)) {
-      t[0] = 0.0;
-      if (pair) t[1] = 0.0;
-    } else if (tn2 > radius * radius) {
-      const double shrink = radius / std::sqrt(tn2);
-      t[0] *= shrink;
-      if (pair) t[1] *= shrink;
-    }
-  }
-}
-
 std::vector<Vec6> row_scales(const ContactSystem &sys)
 {
   std::vector<Vec6> diagonal(sys.num_contacts());

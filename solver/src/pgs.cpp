@@ -58,7 +58,7 @@ void sweep(const ContactSystem &sys, const Cones &cones, const Vector &b,
       old[i] = lc[i];
       lc[i] += (b[at + i] - u[i] - sigma[at + i] * old[i]) * inv_scale[c][i];
     }
-    cones.project(lc, c);
+    cones.project_rows<R>(lc, c);
     for (int i = 0; i < R; ++i) {
       delta[i] = lc[i] - old[i];
       norms[0] += delta[i] * delta[i];
@@ -102,7 +102,7 @@ PgsResult pgs(const ContactSystem &sys, const Exchange &ex, const Cones &cones, 
   }
   for (int s = 0; s < control.max_sweeps; ++s) {
     // dv follows this process's updates; `moved` collects them for the other processes.
-    dv_start = dv;
+    if (ex.has_halo()) dv_start = dv;
     lambda_start = lambda;
     if (blocks) blocks->correct(b, lambda, dv);
     double norms[2] = {0, 0}; // ||change||^2, ||lambda||^2
@@ -111,10 +111,12 @@ PgsResult pgs(const ContactSystem &sys, const Exchange &ex, const Cones &cones, 
     else
       sweep<3>(sys, cones, b, inv_scale, ex.local_owners(), lambda, dv, norms);
     // Every process's updates on every body: the sum of the local changes, owners and ghosts.
-    moved = dv - dv_start;
-    ex.reverse_sum(moved);
-    ex.forward(moved);
-    dv = dv_start + moved;
+    if (ex.has_halo()) {
+      moved = dv - dv_start;
+      ex.reverse_sum(moved);
+      ex.forward(moved);
+      dv = dv_start + moved;
+    }
     ex.sum(norms, 2);
     ++res.sweeps;
     if (!std::isfinite(norms[0]) || !std::isfinite(norms[1])) {

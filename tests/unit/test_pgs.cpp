@@ -59,6 +59,41 @@ TEST(Pgs, ConvergesToTheSettledDirectAnswer)
   EXPECT_LT(rel_diff(velocity_change(pr.sys, serial_exchange(), lambda), ref.dv), 1e-5);
 }
 
+namespace {
+
+// One process without ghosts that says it has a halo: the sweeps take the exchange path
+// (copies, reverse_sum, forward) that SerialExchange lets them skip.
+class HaloExchange final : public Exchange {
+ public:
+  void forward(Vector &) const override {}
+  void reverse_sum(Vector &) const override {}
+  void sum(double *, int) const override {}
+  void max(double *, int) const override {}
+  long exclusive_prefix_sum(long) const override { return 0; }
+};
+
+} // namespace
+
+// Skipping the halo round trip changes nothing but round-off: the same sweeps, the same
+// stop, and the impulses of both paths agree to 1e-12 on a frictional pile.
+TEST(Pgs, SkippingAnEmptyHaloChangesNothing)
+{
+  EXPECT_FALSE(serial_exchange().has_halo());
+  EXPECT_TRUE(HaloExchange().has_halo());
+  Problem pr = pile(60, 0.4);
+  const Cones cones(pr.sys);
+  const std::vector<Vec6> scale = row_scales(pr.sys);
+  PgsControl control{2000, 0.0, 2000};
+  control.accuracy = 1e-8;
+  Vector fast = Vector::Zero(pr.sys.contact_dofs()), halo = fast;
+  const PgsResult a = pgs(pr.sys, serial_exchange(), cones, pr.b, scale, fast, control);
+  const PgsResult b = pgs(pr.sys, HaloExchange(), cones, pr.b, scale, halo, control);
+  EXPECT_EQ(a.reason, StopReason::converged);
+  EXPECT_EQ(a.sweeps, b.sweeps);
+  EXPECT_GT(a.sweeps, 20);
+  EXPECT_LT(rel_diff(fast, halo), 1e-12);
+}
+
 TEST(Pgs, TypedStopReasons)
 {
   Problem pr = pile(60, 0.4);

@@ -19,6 +19,9 @@ class Exchange {
   virtual void forward(Vector &body_vec) const = 0;
   // Add every ghost's value into its owner, then zero the ghosts.
   virtual void reverse_sum(Vector &body_vec) const = 0;
+  // False when forward and reverse_sum do nothing (one process and no ghost bodies), so that
+  // callers may skip the copies around them.
+  virtual bool has_halo() const { return true; }
   // Global sum over all processes, in place.
   virtual void sum(double *values, int n) const = 0;
   // Global maximum over all processes, in place.
@@ -52,6 +55,7 @@ class SerialExchange final : public Exchange {
  public:
   void forward(Vector &) const override {}
   void reverse_sum(Vector &) const override {}
+  bool has_halo() const override { return false; }
   void sum(double *, int) const override {}
   void max(double *, int) const override {}
   long exclusive_prefix_sum(long) const override { return 0; }
