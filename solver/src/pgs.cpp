@@ -100,9 +100,10 @@ PgsResult pgs(const ContactSystem &sys, const Exchange &ex, const Cones &cones, 
     blocks =
         std::make_unique<FibreBlocks>(sys, ex.local_owners(), cones, control.block_weight, &normal);
   }
+  const bool halo = ex.has_halo(); // else the round trip below is the identity
   for (int s = 0; s < control.max_sweeps; ++s) {
     // dv follows this process's updates; `moved` collects them for the other processes.
-    if (ex.has_halo()) dv_start = dv;
+    if (halo) dv_start = dv;
     lambda_start = lambda;
     if (blocks) blocks->correct(b, lambda, dv);
     double norms[2] = {0, 0}; // ||change||^2, ||lambda||^2
@@ -111,7 +112,7 @@ PgsResult pgs(const ContactSystem &sys, const Exchange &ex, const Cones &cones, 
     else
       sweep<3>(sys, cones, b, inv_scale, ex.local_owners(), lambda, dv, norms);
     // Every process's updates on every body: the sum of the local changes, owners and ghosts.
-    if (ex.has_halo()) {
+    if (halo) {
       moved = dv - dv_start;
       ex.reverse_sum(moved);
       ex.forward(moved);

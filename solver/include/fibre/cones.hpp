@@ -68,7 +68,7 @@ template <int R> inline void Cones::project_rows(double *l, int c) const
   l[0] = l[0] > 0 ? l[0] : 0.0; // also NaN -> 0
   if (!std::isfinite(l[0])) l[0] = 0.0;
   const double *coeff = coeff_.data() + 3 * std::size_t(c);
-  for (int k = 0; k < (R == 6 ? 3 : 1); ++k) {
+  for (int k = 0; k < num_cones(R); ++k) {
     double *t = l + kCones[k].first;
     const bool pair = kCones[k].size == 2;
     const double radius = coeff[k] * l[0];
