@@ -315,6 +315,18 @@ void FixFibreContact::warn_pair_computes()
   }
 }
 
+// Below 2 steps SPOOK's damping lets a contact stiffer than the step rings (doc page,
+// "Regularization"): a settled pile keeps moving and spheres are thrown off it.
+void FixFibreContact::warn_short_damping()
+{
+  const double d = settings_.model.damping;
+  if (comm->me == 0 && d < 2.0)
+    warn(error, FLERR,
+         "Fix fibre_contact: damping " + fibre::format_g(d) +
+             " is below 2 steps: a contact stiffer than the time step can resolve rings "
+             "instead of coming to rest (damping 2, the default, damps it critically)");
+}
+
 // Another fix that moves the same atoms would integrate them twice.
 void FixFibreContact::warn_double_integration()
 {
@@ -343,6 +355,7 @@ void FixFibreContact::init()
   detection_->init_walls(settings_.walls);
   warn_double_integration();
   warn_pair_computes();
+  warn_short_damping();
   read_coefficients();
   if (comm->me == 0) logmesg(lmp, "fix fibre_contact: " + fibre::describe(settings_) + "\n");
 }

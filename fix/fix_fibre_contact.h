@@ -61,6 +61,7 @@ class FixFibreContact : public Fix {
   void check_pair_style(bool at_init);
   void warn_double_integration();
   void warn_pair_computes();
+  void warn_short_damping();
   void read_coefficients();
   void check_finite(const char *what, double **array, int nvalues) const;
   void smallest_body(const std::vector<fibre::Body> &bodies);

@@ -88,7 +88,12 @@ PgsResult pgs(const ContactSystem &sys, const Exchange &ex, const Cones &cones, 
   if (control.fibre_blocks)
     for (int c = 0; c < nc; ++c) cones.project(lambda.data() + Eigen::Index(rows) * c, c);
   Vector dv = velocity_change(sys, ex, lambda);
-  Vector dv_start, moved, lambda_start; // reused by every sweep
+  Vector dv_start, moved; // reused by every sweep
+  // Impulses to fall back on when a sweep turns non-finite: taken every kCheckpointSweeps
+  // sweeps (a copy per sweep was 5% of a stiff run), and every sweep for nonlinear CG, whose
+  // direction is the sweep's change.
+  constexpr int kCheckpointSweeps = 16;
+  Vector lambda_start;
   double best = INFINITY;
   int since_best = 0;
   Vector direction, change; // nonlinear CG
@@ -104,7 +109,7 @@ PgsResult pgs(const ContactSystem &sys, const Exchange &ex, const Cones &cones, 
   for (int s = 0; s < control.max_sweeps; ++s) {
     // dv follows this process's updates; `moved` collects them for the other processes.
     if (halo) dv_start = dv;
-    lambda_start = lambda;
+    if (control.nonlinear_cg || s % kCheckpointSweeps == 0) lambda_start = lambda;
     if (blocks) blocks->correct(b, lambda, dv);
     double norms[2] = {0, 0}; // ||change||^2, ||lambda||^2
     if (rows == 6)

@@ -404,13 +404,16 @@ StepResult StepSolver::run(const Vector *warm)
   for (int c = 0; c < nc_; ++c) diagonal_[c] = diagonal_entries(sys_, c);
   row_scales_ = row_scales(diagonal_, rows_);
   Vector lambda = initial_impulses(warm);
-  // The projected warm start and its residual: the step never ends worse than the sweeps
-  // alone would leave it from there.
-  Vector start = lambda;
-  project(start);
-  const double start_residual =
-      sweeps_only() ? 0.0 : complementarity(sys_, ex_, cones_, b_full_, start, row_scales_);
-  if (!sweeps_only()) active_set_loop(lambda, res);
+  // After a linear pass, the projected warm start and its residual: the step never ends worse
+  // than the sweeps alone would leave it from there (and the sweeps alone start there).
+  Vector start;
+  double start_residual = 0.0;
+  if (!sweeps_only()) {
+    start = lambda;
+    project(start);
+    start_residual = complementarity(sys_, ex_, cones_, b_full_, start, row_scales_);
+    active_set_loop(lambda, res);
+  }
   // Feasible impulses, then projected Gauss-Seidel sweeps while they are not accurate enough.
   // (Projecting an unsettled pass alone could zero a tensile impulse that balances large
   // compressive ones and kick the bodies between them: 29 m/s in one silo step.)

@@ -133,6 +133,7 @@ WARN_CASES = [
      {}),
     ("pair_local", "", "compute pl (pair/local) reads the pair style, whose forces are switched "
      "off", {"post": "compute pl all pair/local dist"}),
+    ("short_damping", "damping 0.5", "Fix fibre_contact: damping 0.5 is below 2 steps", {}),
 ]
 
 

@@ -297,6 +297,74 @@ TEST(ContactSolver, RecoverySpeedBoundsRigidRowsNotTheMaterialsSpring)
   EXPECT_LE(vz, v_rec * (1.0 + 1e-6));
 }
 
+// SPOOK's damping d (in steps) of a contact stiffer than the step can resolve: the step maps the
+// overlap's deviation e from its rest value as a linear recurrence with the characteristic
+// polynomial mu^2 - (1 - 3 Y) mu + Y, Y = 1 / (1 + 4 d) (doc/design.md section 2). d = 2 is its
+// double root 1/3, critical damping: e crosses zero at most once. Below 2 the roots are complex
+// and the contact rings; a unilateral contact that rings lets go on its outward swings.
+namespace {
+
+// Overlap deviations (overlap / d_eq - 1) of a sphere released at rest 10% deeper than its rest
+// overlap d_eq on a Hertz contact with omega h = 34, every step damped over d steps.
+std::vector<double> stiff_contact_deviations(double d, int steps)
+{
+  const double m = 0.2, r = 0.25;
+  PairCoefficients law;
+  law.set = true;
+  law.normal = NormalLaw::hertz_material;
+  law.k_n = 5e12;
+  const double weight = m * kG;
+  const double d_eq = std::cbrt(weight * weight / (law.k_n * law.k_n * r));
+  StepOptions o = base_options();
+  o.stop.tol = 1e-12;
+  std::vector<Body> bodies{sphere(m, r, Vec3(0, 0, r - 1.1 * d_eq))};
+  std::vector<double> deviation;
+  double force = weight; // the last step's normal force
+  for (int s = 0; s < steps; ++s) {
+    Contact c = sphere_wall_contact(bodies, 0, Vec3::UnitZ(), bodies[0].x.z());
+    std::array<double, kMaxRows> rigid{};
+    rigid.fill(1e-16);
+    material_compliance(law, r, -c.gap, force, rigid, c.compliance, c.elastic);
+    c.damping = d;
+    ContactSystem sys(bodies, {c}, 3, spook());
+    const StepResult res = solve(sys, o);
+    EXPECT_TRUE(res.converged);
+    force = res.lambda[0] / kH;
+    bodies[0].v += kH * bodies[0].force / m + res.dv.head<3>();
+    bodies[0].x += kH * bodies[0].v;
+    deviation.push_back((r - bodies[0].x.z()) / d_eq - 1.0);
+  }
+  return deviation;
+}
+
+int sign_changes(const std::vector<double> &e)
+{
+  int n = 0;
+  for (std::size_t k = 1; k < e.size(); ++k)
+    if (e[k] * e[k - 1] < 0) ++n;
+  return n;
+}
+
+} // namespace
+
+TEST(ContactSolver, StiffContactDampedOverTwoStepsDoesNotRing)
+{
+  const std::vector<double> e = stiff_contact_deviations(2.0, 16);
+  EXPECT_LE(sign_changes(e), 1);
+  // e_k ~ (A + B k) / 3^k: the ratio tends to 1/3 from above
+  EXPECT_GT(e[12] / e[11], 1.0 / 3.0);
+  EXPECT_LT(e[12] / e[11], 0.4);
+  EXPECT_LT(std::abs(e.back()), 1e-6);
+}
+
+TEST(ContactSolver, StiffContactDampedOverLessRings)
+{
+  for (double d : {1.0, 0.25}) {
+    const std::vector<double> e = stiff_contact_deviations(d, 16);
+    EXPECT_GE(sign_changes(e), 5) << "d = " << d;
+  }
+}
+
 // Two spheres flying apart with a positive gap are released; approaching ones are not.
 TEST(ContactSolver, SeparatingPairIsReleased)
 {

@@ -54,7 +54,8 @@ struct PgsResult {
 // every row active; `scale` comes from row_scales(sys). In parallel each process sweeps its
 // own contacts; bodies shared with another process see the other's updates at the next sweep
 // (block Jacobi across processes): one reverse and one forward halo exchange per sweep.
-// A sweep that produces non-finite values is undone and stops with StopReason::non_finite.
+// A sweep that produces non-finite values stops with StopReason::non_finite, its impulses
+// back at the last checkpoint (at most 16 sweeps back; the start for the first 16).
 PgsResult pgs(const ContactSystem &sys, const Exchange &ex, const Cones &cones, const Vector &b,
               const std::vector<Vec6> &scale, Vector &lambda, const PgsControl &control);
 
