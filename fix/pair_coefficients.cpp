@@ -89,7 +89,7 @@ void read_granular(const std::string &bytes, int ntypes, PairReading &out)
                 : model[4] == 2 ? fibre::TwistLaw::marshall
                                 : fibre::TwistLaw::none;
       p.twist_coeff = model[4] == 1 ? twist[2] : 0.0;
-      p.restitution = model[1] == kTsuji ? fibre::restitution_from_tsuji(normal[1]) : -1.0;
+      p.limit_damping = model[5] != 0;
       // elastic laws (compliance material); dmt's elastic part is hertz/material's, jkr's
       // stored constants are not the Hertz ones
       const fibre::NormalLaw laws[5] = {fibre::NormalLaw::hooke, fibre::NormalLaw::hertz,
@@ -103,6 +103,13 @@ void read_granular(const std::string &bytes, int ntypes, PairReading &out)
       p.k_t = tangential[0];
       p.k_roll = model[3] == 1 ? roll[0] : 0.0;
       p.k_twist = model[4] == 1 ? twist[0] : 0.0;
+      // the rebound LAMMPS's own law gives (dmt and jkr: their Hertz part)
+      if (model[1] == kTsuji) {
+        p.damping_alpha = normal[1];
+        p.restitution = fibre::rebound_restitution(model[0] == 0 ? fibre::NormalLaw::hooke
+                                                                 : fibre::NormalLaw::hertz,
+                                                   normal[1], p.limit_damping);
+      }
       cohesion = cohesion || model[0] == kDmt || model[0] == kJkr;
       if (model[1] != kTsuji)
         out.notes.push_back("types " + std::to_string(i) + " " + std::to_string(j) + ": damping " +

@@ -56,10 +56,17 @@ std::string MaterialTable::mix()
       p.k_t = stiff(a.k_t, b.k_t);
       p.k_roll = geom(a.k_roll, b.k_roll);
       p.k_twist = geom(a.k_twist, b.k_twist);
-      p.restitution = a.restitution >= 0 && b.restitution >= 0
-                          ? restitution_from_tsuji(
-                                geom(tsuji_damping(a.restitution), tsuji_damping(b.restitution)))
-                          : -1.0;
+      // LAMMPS mixes Tsuji's alpha; the rebound then follows from the mixed law
+      p.limit_damping = a.limit_damping || b.limit_damping;
+      if (a.damping_alpha >= 0 && b.damping_alpha >= 0) {
+        p.damping_alpha = geom(a.damping_alpha, b.damping_alpha);
+        p.restitution = rebound_restitution(p.normal, p.damping_alpha, p.limit_damping);
+      } else {
+        p.restitution = a.restitution >= 0 && b.restitution >= 0
+                            ? restitution_from_tsuji(
+                                  geom(tsuji_damping(a.restitution), tsuji_damping(b.restitution)))
+                            : -1.0;
+      }
     }
   return "";
 }
@@ -83,6 +90,37 @@ double restitution_from_tsuji(double alpha)
     (tsuji_damping(mid) > alpha ? lo : hi) = mid;
   }
   return 0.5 * (lo + hi);
+}
+
+double rebound_restitution(NormalLaw law, double alpha, bool limit_damping)
+{
+  if (!(alpha >= 0)) return 0.0;
+  const bool hooke = law == NormalLaw::hooke;
+  // d'' = -F(d, d') with m = k = 1, from d = 0 at approach speed 1
+  const auto force = [&](double d, double v) {
+    const double x = std::max(d, 0.0);
+    const double f = hooke ? x + alpha * v : x * std::sqrt(x) + alpha * std::sqrt(std::sqrt(x)) * v;
+    return limit_damping ? std::max(f, 0.0) : f;
+  };
+  constexpr double dt = 1e-4, t_end = 100.0; // a collision lasts about 3.2 (hertz), pi (hooke)
+  double d = 0.0, v = 1.0;
+  for (double t = 0.0; t < t_end; t += dt) {
+    const double k1d = v, k1v = -force(d, v);
+    const double k2d = v + 0.5 * dt * k1v, k2v = -force(d + 0.5 * dt * k1d, v + 0.5 * dt * k1v);
+    const double k3d = v + 0.5 * dt * k2v, k3v = -force(d + 0.5 * dt * k2d, v + 0.5 * dt * k2v);
+    const double k4d = v + dt * k3v, k4v = -force(d + dt * k3d, v + dt * k3v);
+    const double d_next = d + dt / 6.0 * (k1d + 2.0 * k2d + 2.0 * k3d + k4d);
+    const double v_next = v + dt / 6.0 * (k1v + 2.0 * k2v + 2.0 * k3v + k4v);
+    if (t > 0.0 && d_next <= 0.0) { // the overlap closes within this step
+      const double f = d / (d - d_next);
+      return std::clamp(-(v + f * (v_next - v)), 0.0, 1.0);
+    }
+    if (limit_damping && v_next < 0.0 && force(d_next, v_next) <= 0.0)
+      return std::clamp(-v_next, 0.0, 1.0); // no force left: the bodies part at this speed
+    d = d_next;
+    v = v_next;
+  }
+  return 0.0; // overdamped: the overlap never closes
 }
 
 FrictionParams contact_friction(const PairCoefficients &p, double r_eff, double overlap)
@@ -145,6 +183,8 @@ std::vector<std::string> MaterialTable::describe() const
               : p.twist == TwistLaw::marshall ? std::string("marshall")
                                               : std::string("none");
       line += ", restitution " + (p.restitution >= 0 ? g(p.restitution) : std::string("none"));
+      if (p.damping_alpha >= 0)
+        line += " (the rebound of damping tsuji, alpha " + g(p.damping_alpha) + ")";
       lines.push_back(line);
     }
   return lines;

@@ -10,14 +10,19 @@ friction on the walls, settled for 12 s, then 10 snapshots over 1 s. Checks:
   averaged over the snapshots' run, within 3% of the weight (a static pack);
 - against the native twin: Janssen's saturation pressure p_sat (the fit of
   p_sat (1 - exp(-(h - z) / lambda)) to the side-wall pressure by height, examples/janssen/
-  janssen.py), the deep pressure and the floor's share each within 10% (over three seeds the
-  means agree to 1.8%, 3.8% and 2.5%: examples/README.md; one seed's packing scatters more).
+  janssen.py), the deep pressure and the floor's share, each the mean of seeds 4767 and 1031,
+  within 10% (over three seeds the means agree to 2.8%, 1.0% and 4.2%: examples/README.md).
+  One seed's p_sat scatters by up to 13% (fibre: 33.0 to 41.9 over three seeds), too much for
+  a one-seed check.
 """
 
+import argparse
 import os
 import sys
 
 import fibre_e2e as e2e
+
+SEEDS = (4767, 1031)
 
 
 def main():
@@ -28,33 +33,49 @@ def main():
     import janssen  # examples/janssen/janssen.py, copied with the scene
 
     results = {}
-    for method, name in (("fibre", "in.janssen"), ("native", "in.janssen.native")):
-        with open(os.path.join(args.workdir, name)) as f:
-            deck = f.read()
-        run = e2e.run_lmp(args, deck, method, variables={"seed": 4767})
-        if not ck.ran(run, "%s: janssen deck completes" % method):
-            continue
-        results[method] = janssen.measure(args.workdir, method)
-        share = results[method]["floor_share"]
-        ck.check(share < 0.8, "%s: the side walls carry part of the weight (floor < 80%%)"
-                 % method, "floor / weight = %.3f" % share)
-        if method == "fibre":
-            snaps = janssen.side_forces(args.workdir, "fibre")
-            weight = snaps[-1][3]
-            rows = run.thermo[-1]
-            load = sum(-(r["f_fc[1][3]"] + r["f_fc[2][3]"] + r["f_fc[3][3]"]) for r in rows)
-            load /= len(rows)
-            ck.check(abs(load / weight - 1.0) < 0.03,
-                     "fibre: the walls' z loads balance the weight within 3%",
-                     "mean load %.1f N, weight %.1f N" % (load, weight))
-    if len(results) == 2:
-        f, n = results["fibre"], results["native"]
+    for seed in SEEDS:
+        run_args = argparse.Namespace(**vars(args))
+        run_args.workdir = os.path.join(args.workdir, "seed%d" % seed)
+        os.makedirs(run_args.workdir, exist_ok=True)
+        e2e.copy_scene(args.source, "janssen", run_args.workdir)
+        for method, name in (("fibre", "in.janssen"), ("native", "in.janssen.native")):
+            measured = run_twin(run_args, ck, janssen, seed, method, name)
+            if measured:
+                results.setdefault(method, []).append(measured)
+    if all(len(results.get(m, [])) == len(SEEDS) for m in ("fibre", "native")):
+        mean = {m: {key: sum(r[key] for r in results[m]) / len(SEEDS)
+                    for key in ("p_sat", "deep", "floor_share")} for m in results}
+        f, n = mean["fibre"], mean["native"]
         for key, what in (("p_sat", "Janssen's saturation pressure"),
                           ("deep", "deep side-wall pressure"), ("floor_share", "floor's share")):
             ratio = f[key] / n[key]
-            ck.check(abs(ratio - 1.0) < 0.10, "%s within 10%% of native" % what,
+            ck.check(abs(ratio - 1.0) < 0.10, "%s within 10%% of native (mean of seeds %s)"
+                     % (what, ", ".join(str(s) for s in SEEDS)),
                      "fibre %.3f, native %.3f (ratio %.3f)" % (f[key], n[key], ratio))
     ck.close()
+
+
+def run_twin(args, ck, janssen, seed, method, name):
+    with open(os.path.join(args.workdir, name)) as f:
+        deck = f.read()
+    run = e2e.run_lmp(args, deck, method, variables={"seed": seed})
+    tag = "%s, seed %d" % (method, seed)
+    if not ck.ran(run, "%s: janssen deck completes" % tag):
+        return None
+    measured = janssen.measure(args.workdir, method)
+    share = measured["floor_share"]
+    ck.check(share < 0.8, "%s: the side walls carry part of the weight (floor < 80%%)" % tag,
+             "floor / weight = %.3f" % share)
+    if method == "fibre":
+        snaps = janssen.side_forces(args.workdir, "fibre")
+        weight = snaps[-1][3]
+        rows = run.thermo[-1]
+        load = sum(-(r["f_fc[1][3]"] + r["f_fc[2][3]"] + r["f_fc[3][3]"]) for r in rows)
+        load /= len(rows)
+        ck.check(abs(load / weight - 1.0) < 0.03,
+                 "%s: the walls' z loads balance the weight within 3%%" % tag,
+                 "mean load %.1f N, weight %.1f N" % (load, weight))
+    return measured
 
 
 if __name__ == "__main__":

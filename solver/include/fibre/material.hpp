@@ -35,7 +35,11 @@ struct PairCoefficients {
   double twist_coeff = 0.0; // sds: mu_tw (length)
   // Newton's coefficient of restitution, or < 0 when the pair style's damping law has none
   // (a viscous damping): the contact is then plastic unless the front end's keyword says more.
+  // With LAMMPS's damping tsuji it is the rebound of the pair style's own damped law
+  // (rebound_restitution), not the e typed in pair_coeff.
   double restitution = -1.0;
+  double damping_alpha = -1.0;        // LAMMPS's damping tsuji: its coefficient alpha (< 0: none)
+  bool limit_damping = false;         // LAMMPS's limit_damping: the normal force never pulls
   NormalLaw normal = NormalLaw::none; // none: no elastic constants (compliance auto)
   double k_n = 0.0;
   TangentialLaw tangential = TangentialLaw::none;
@@ -71,6 +75,14 @@ class MaterialTable {
 // that LAMMPS's `damping tsuji` applies to hertz/material's e), and its inverse on [0, 1].
 double tsuji_damping(double e);
 double restitution_from_tsuji(double alpha);
+
+// The coefficient of restitution that a head-on collision under LAMMPS's damped normal law
+// gives: overlap d, hooke F = k d + alpha sqrt(m k) d', hertz F = k a d + alpha sqrt(m k a) d'
+// with a = sqrt(r_eff d) (damping tsuji). The law is scale free, so this depends on alpha
+// alone; it is integrated once in units m = k = v = 1 until the overlap closes, or with
+// limit_damping until the force vanishes. Tsuji's fit names another e: LAMMPS's `hertz/material
+// E 0.1 ...` rebounds at 0.234.
+double rebound_restitution(NormalLaw law, double alpha, bool limit_damping = false);
 
 // The friction of one contact (radius r_eff, overlap >= 0) from its pair's coefficients:
 // mu_twist per unit r_eff as FrictionParams keeps it.
