@@ -9,7 +9,7 @@
   and a type-2 sphere (e 0.9) dropped side by side rebound to e'^2 h each, within 2%, where
   e' is the rebound of LAMMPS's own damped law: native LAMMPS (/usr/bin/lmp) runs two
   spheres of that pair_coeff head on, and e' is their separation / approach ratio (0.439
-  and 0.928, not the 0.3 and 0.9 typed).
+  and 0.928, not the 0.3 and 0.9 typed); on one process and on two (one sphere on each).
 - The older styles: gran/hooke/history's xmu is every pair's mu (a sphere slides with
   xmu 0.2), and the log says which coefficients were read and what is not used.
 - coefficients fix: the pair style is ignored and the fix's defaults hold (mu 0.5: sticks).
@@ -117,22 +117,26 @@ def native_rebound(args, coeff, tag):
     return float(found[-1]) if found else None
 
 
-def drop(args, ck):
-    h = 2.0
-    atoms = [(1, -3.0, h + 0.5), (2, 3.0, h + 0.5)]
-    tag = "drop_two_types"
-    run = e2e.run_lmp(args, deck(GRANULAR, "0 0 -1", atoms, "", 1, 4000), tag)
-    if not ck.ran(run, "%s: run completes" % tag):
-        return
-    rows = run.thermo[-1]
+def native_rebounds(args, ck):
     rebounds = {}
     for k, line in enumerate(GRANULAR.splitlines()[1:], start=1):
         coeff = line.split(None, 3)[3]
         rebounds[k] = native_rebound(args, coeff, "native_pair_type%d" % k)
         typed = float(coeff.split()[2])  # hertz/material E e nu
         ck.check(rebounds[k] is not None and typed < rebounds[k] < 1.0,
-                 "%s: native LAMMPS's head-on rebound of type %d (e %g typed) is %s" %
-                 (tag, k, typed, rebounds[k]))
+                 "native LAMMPS's head-on rebound of type %d (e %g typed) is %s" %
+                 (k, typed, rebounds[k]))
+    return rebounds
+
+
+def drop(args, ck, rebounds, np):
+    h = 2.0
+    atoms = [(1, -3.0, h + 0.5), (2, 3.0, h + 0.5)]
+    tag = "drop_two_types_np%d" % np
+    run = e2e.run_lmp(args, deck(GRANULAR, "0 0 -1", atoms, "", np, 4000), tag, np=np)
+    if not ck.ran(run, "%s: run completes" % tag):
+        return
+    rows = run.thermo[-1]
     for k, e in rebounds.items():
         if e is None:
             continue
@@ -185,7 +189,9 @@ def main():
                  "incline_types: the log lists the coefficients read per type pair")
     incline(args, ck, "incline_types_np2", GRANULAR, "", [(True, 0.2), (False, 0.8)], np=2)
     incline(args, ck, "incline_typed_mu", GRANULAR, "mu 0.9", [(False, 0.9), (False, 0.9)])
-    drop(args, ck)
+    rebounds = native_rebounds(args, ck)
+    drop(args, ck, rebounds, 1)
+    drop(args, ck, rebounds, 2)
     hooke = "pair_style gran/hooke/history 2000.0 NULL 50.0 NULL 0.2 0\npair_coeff * *"
     run = incline(args, ck, "incline_gran_hooke", hooke, "mu_roll 1.0",
                   [(True, 0.2), (True, 0.2)], types=(1, 1))
