@@ -38,6 +38,13 @@ TEST(Material, ReboundOfLammpsDampedLaws)
                 std::exp(-M_PI * zeta / std::sqrt(1.0 - zeta * zeta)), 1e-5)
         << "alpha " << alpha;
   }
+  // LIGGGHTS's Hertz damping, 2 sqrt(5/6) |beta| sqrt(S_n m) with S_n = 3/2 k_n a and
+  // beta = ln e / sqrt(ln^2 e + pi^2), is alpha = sqrt(5) |beta|: built to rebound at e
+  for (double e : {0.1, 0.3, 0.5, 0.9}) {
+    const double beta = std::log(e) / std::sqrt(std::log(e) * std::log(e) + M_PI * M_PI);
+    EXPECT_NEAR(rebound_restitution(NormalLaw::hertz, std::sqrt(5.0) * std::abs(beta)), e, 5e-4)
+        << "e " << e;
+  }
   EXPECT_NEAR(rebound_restitution(NormalLaw::hertz, 0.0), 1.0, 1e-6); // undamped
   EXPECT_EQ(rebound_restitution(NormalLaw::hooke, 3.0), 0.0);         // overdamped
   EXPECT_EQ(rebound_restitution(NormalLaw::hertz, -1.0), 0.0);        // no damping law
