@@ -102,16 +102,17 @@ double rebound_restitution(NormalLaw law, double alpha, bool limit_damping)
     const double f = hooke ? x + alpha * v : x * std::sqrt(x) + alpha * std::sqrt(std::sqrt(x)) * v;
     return limit_damping ? std::max(f, 0.0) : f;
   };
-  constexpr double dt = 1e-4, t_end = 100.0; // a collision lasts about 3.2 (hertz), pi (hooke)
+  constexpr double dt = 1e-4; // a collision lasts about 3.2 (hertz), pi (hooke)
+  constexpr int max_steps = 1000000;
   double d = 0.0, v = 1.0;
-  for (double t = 0.0; t < t_end; t += dt) {
+  for (int k = 0; k < max_steps; ++k) {
     const double k1d = v, k1v = -force(d, v);
     const double k2d = v + 0.5 * dt * k1v, k2v = -force(d + 0.5 * dt * k1d, v + 0.5 * dt * k1v);
     const double k3d = v + 0.5 * dt * k2v, k3v = -force(d + 0.5 * dt * k2d, v + 0.5 * dt * k2v);
     const double k4d = v + dt * k3v, k4v = -force(d + dt * k3d, v + dt * k3v);
     const double d_next = d + dt / 6.0 * (k1d + 2.0 * k2d + 2.0 * k3d + k4d);
     const double v_next = v + dt / 6.0 * (k1v + 2.0 * k2v + 2.0 * k3v + k4v);
-    if (t > 0.0 && d_next <= 0.0) { // the overlap closes within this step
+    if (k > 0 && d_next <= 0.0) { // the overlap closes within this step
       const double f = d / (d - d_next);
       return std::clamp(-(v + f * (v_next - v)), 0.0, 1.0);
     }

@@ -89,9 +89,9 @@ PgsResult pgs(const ContactSystem &sys, const Exchange &ex, const Cones &cones, 
     for (int c = 0; c < nc; ++c) cones.project(lambda.data() + Eigen::Index(rows) * c, c);
   Vector dv = velocity_change(sys, ex, lambda);
   Vector dv_start, moved; // reused by every sweep
-  // Impulses to fall back on when a sweep turns non-finite: taken every kCheckpointSweeps
-  // sweeps (a copy per sweep was 5% of a stiff run), and every sweep for nonlinear CG, whose
-  // direction is the sweep's change.
+  // Impulses to fall back on when a sweep turns non-finite: a copy every kCheckpointSweeps
+  // sweeps, not every sweep (stiff steps take hundreds), and every sweep for nonlinear CG,
+  // whose direction is the sweep's change.
   constexpr int kCheckpointSweeps = 16;
   Vector lambda_start;
   double best = INFINITY;
