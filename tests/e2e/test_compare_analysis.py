@@ -1,0 +1,53 @@
+"""The comparison tool's silo analysis (examples/compare/compare.py steady_rate) on discharge
+curves with known answers, no LAMMPS run:
+
+- a steady flow of 10 kg/s: the rate to 1e-9, not clogged;
+- a flow that stops for good with mass left: clogged;
+- a flow held by an arch that lets a sphere through now and then (0.05 kg every 0.5 s, as
+  seed 1031 of the D = 3.5 silo did): clogged;
+- a flow that arches for 1 s and runs on: not clogged;
+- a silo that runs empty: not clogged.
+"""
+
+import os
+import sys
+
+import numpy as np
+
+import fibre_e2e as e2e
+
+
+def curve(rates, m0=200.0, dt=0.1):
+    """m(t) from a rate per 0.5 s window, opened at t = 0, never below 0."""
+    t = np.arange(0.0, 0.5 * len(rates) + 1e-9, dt)
+    m = np.empty_like(t)
+    for k, tk in enumerate(t):
+        out = 0.0
+        for w, rate in enumerate(rates):
+            out += rate * min(max(tk - 0.5 * w, 0.0), 0.5)
+        m[k] = max(m0 - out, 0.0)
+    return t, m
+
+
+def main():
+    args = e2e.parse_args()
+    sys.path.insert(0, os.path.join(args.source, "examples", "compare"))
+    import compare
+
+    ck = e2e.Checks("compare.py: discharge rate and clogs")
+    rate, _, _, clogged = compare.steady_rate(*curve([10.0] * 14))
+    ck.check(abs(rate - 10.0) < 1e-9 and not clogged, "steady flow: its rate, no clog",
+             "rate %.12g, clogged %s" % (rate, clogged))
+    _, _, _, clogged = compare.steady_rate(*curve([10.0] * 8 + [0.0] * 6))
+    ck.check(clogged, "a flow that stops with mass left is clogged")
+    _, _, _, clogged = compare.steady_rate(*curve([10.0] * 8 + [0.1, 0.0, 0.6, 0.0, 0.1, 0.0]))
+    ck.check(clogged, "an arch that lets a sphere through now and then is a clog")
+    _, _, _, clogged = compare.steady_rate(*curve([10.0] * 6 + [0.0, 0.0] + [10.0] * 6))
+    ck.check(not clogged, "an arch that breaks again is no clog")
+    _, _, _, clogged = compare.steady_rate(*curve([40.0] * 14))
+    ck.check(not clogged, "a silo that runs empty is no clog")
+    ck.close()
+
+
+if __name__ == "__main__":
+    main()
