@@ -7,8 +7,8 @@
 - The fix's typed mu overrides every pair: with mu 0.9 both stick.
 - Restitution per type from hertz/material's e with damping tsuji: a type-1 sphere (e 0.3)
   and a type-2 sphere (e 0.9) dropped side by side rebound to e'^2 h each, within 2%, where
-  e' is the rebound of LAMMPS's own damped law: native LAMMPS (/usr/bin/lmp) runs two
-  spheres of that pair_coeff head on, and e' is their separation / approach ratio (0.439
+  e' is the rebound of LAMMPS's own damped law: native LAMMPS (the pair style without the
+  fix) runs two spheres of that pair_coeff head on, and e' is their separation / approach ratio (0.439
   and 0.928, not the 0.3 and 0.9 typed); on one process and on two (one sphere on each).
 - The older styles: gran/hooke/history's xmu is every pair's mu (a sphere slides with
   xmu 0.2), and the log says which coefficients were read and what is not used.
@@ -22,8 +22,6 @@
 
 import math
 import re
-import shutil
-import subprocess
 
 import fibre_e2e as e2e
 
@@ -107,14 +105,10 @@ print "rebound $((vx[2]-vx[1])/2.0)"
 
 
 def native_rebound(args, coeff, tag):
-    lmp = shutil.which("lmp") or "/usr/bin/lmp"
-    path = args.workdir + "/in." + tag
-    with open(path, "w") as f:
-        f.write(NATIVE_PAIR % coeff)
-    out = subprocess.run([lmp, "-in", path, "-log", "none", "-echo", "none"], cwd=args.workdir,
-                         stdout=subprocess.PIPE, stderr=subprocess.STDOUT, timeout=300)
-    found = re.findall(r"^rebound (\S+)", out.stdout.decode("utf-8", "replace"), re.M)
-    return float(found[-1]) if found else None
+    # lmp_fibre without the fix is LAMMPS (Debian's liblammps, as /usr/bin/lmp links it)
+    run = e2e.run_lmp(args, NATIVE_PAIR % coeff, tag)
+    found = re.findall(r"^rebound (\S+)", run.output, re.M)
+    return float(found[-1]) if run.rc == 0 and found else None
 
 
 def native_rebounds(args, ck):
