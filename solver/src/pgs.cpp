@@ -132,7 +132,8 @@ PgsResult pgs(const ContactSystem &sys, const Exchange &ex, const Cones &cones, 
     }
     res.record(norms[1] > 0 ? std::sqrt(norms[0] / norms[1]) : 0.0);
     res.reason = StopReason::max_iterations;
-    const bool done = control.accuracy > 0 ? res.error_estimate() <= control.accuracy
+    const bool done = control.accuracy > 0 ? res.error_estimate() <= control.accuracy &&
+                                                 (res.sweeps >= control.min_sweeps || norms[0] == 0)
                                            : !(norms[0] > control.tol * control.tol * norms[1]);
     if (done) {
       res.reason = StopReason::converged;

@@ -22,8 +22,9 @@ std::string describe(const StepOptions &opt)
          g(opt.stop.tol) + ", pass_tol " + g(opt.pass_tol) + ", maxiter " +
          std::to_string(opt.stop.max_iter) + ", active_set " + std::to_string(opt.active_set_max) +
          ", sweeps " + std::to_string(opt.sweeps) + ", sweep_tol " + g(opt.sweep_tol) +
-         ", rescue_sweeps " + std::to_string(opt.rescue_sweeps) +
-         (opt.sweep_cg ? ", sweep_cg yes" : "") + (opt.sweep_blocks ? ", sweep_blocks yes" : "");
+         ", rescue_sweeps " + std::to_string(opt.rescue_sweeps) + ", min_sweeps " +
+         std::to_string(opt.min_sweeps) + (opt.sweep_cg ? ", sweep_cg yes" : "") +
+         (opt.sweep_blocks ? ", sweep_blocks yes" : "");
 }
 
 namespace {
@@ -282,6 +283,7 @@ void StepSolver::finish(Vector &lambda, StepResult &res) const
   if (opt_.sweeps > 0 && (accuracy || res.complementarity > opt_.sweep_tol)) {
     PgsControl control{opt_.sweeps, opt_.sweep_tol};
     control.accuracy = opt_.accuracy;
+    control.min_sweeps = opt_.min_sweeps;
     control.nonlinear_cg = opt_.sweep_cg || opt_.solver == Method::nncg;
     control.fibre_blocks = opt_.sweep_blocks || opt_.solver == Method::fbgs;
     control.block_weight = opt_.precond.weight;

@@ -59,6 +59,8 @@ CASES = [
     ("pass_tol_missing", "pass_tol", "expected 'pass_tol <positive number>'", {}),
     ("sweeps_negative", "sweeps -1", "expected 'sweeps <non-negative integer>', got '-1'", {}),
     ("sweeps_real", "sweeps 2.5", "expected 'sweeps <non-negative integer>', got '2.5'", {}),
+    ("min_sweeps_negative", "min_sweeps -3",
+     "expected 'min_sweeps <non-negative integer>', got '-3'", {}),
     ("sweep_tol_zero", "sweep_tol 0", "expected 'sweep_tol <positive number>', got '0'", {}),
     ("sweep_tol_missing", "sweep_tol", "expected 'sweep_tol <positive number>'", {}),
     ("sweep_blocks_word", "sweep_blocks maybe", "expected 'sweep_blocks yes|no', got 'maybe'", {}),

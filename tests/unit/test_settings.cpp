@@ -59,8 +59,8 @@ TEST(Settings, NoKeywordsKeepTheDefaults)
   EXPECT_EQ(
       describe(s),
       "form body, solver pgs, precond tree, weight z, tol 0.0001, linear_tol 0.0001, pass_tol "
-      "0.001, maxiter 200, active_set 1, sweeps 2000, sweep_tol 0.001, rescue_sweeps 500, rows "
-      "6, damping 2, "
+      "0.001, maxiter 200, active_set 1, sweeps 2000, sweep_tol 0.001, rescue_sweeps 500, "
+      "min_sweeps 10, rows 6, damping 2, "
       "compliance auto "
       "(0.01 dt^2 / m_min), recovery_speed auto (0.01 r_min / dt), restitution 0, "
       "bounce_speed auto (2 dt |f| / m max, or 0.01 r_min / dt without forces), coefficients "
@@ -119,6 +119,8 @@ TEST(Settings, EveryKeywordSetsWhatItNames)
   EXPECT_FALSE(parse_settings(words("sweep_blocks no")).step.sweep_blocks);
   EXPECT_EQ(parse_settings(words("rescue_sweeps 0")).step.rescue_sweeps, 0);
   EXPECT_EQ(parse_settings(words("rescue_sweeps 2000")).step.rescue_sweeps, 2000);
+  EXPECT_EQ(parse_settings(words("min_sweeps 0")).step.min_sweeps, 0);
+  EXPECT_EQ(parse_settings(words("min_sweeps 25")).step.min_sweeps, 25);
   EXPECT_DOUBLE_EQ(parse_settings(words("recovery_speed 0.3")).model.recovery_speed, 0.3);
   EXPECT_DOUBLE_EQ(parse_settings(words("recovery_speed none")).model.recovery_speed, 0.0);
   const ContactModel automatic = parse_settings(words("recovery_speed auto")).model;

@@ -30,6 +30,8 @@ struct PgsControl {
   bool fibre_blocks = false;
   EdgeWeight block_weight = EdgeWeight::impulse;
   double accuracy = 0; // the error-estimate rule (0: off)
+  // The error-estimate rule stops no sooner than this (a sweep that changes nothing stops).
+  int min_sweeps = 0;
 };
 
 inline constexpr int kRateWindow = 5;
