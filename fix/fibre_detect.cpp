@@ -182,6 +182,7 @@ void LammpsDetection::pair_contacts(const std::vector<fibre::Body> &bodies, doub
         n = dist > 0.0 ? fibre::Vec3(n / dist) : fibre::Vec3::UnitZ();
         fc.contact = fibre::sphere_wall_contact(bodies, atom_body_[g], n, dist - radius[o]);
         fc.contact.wall_type = atom->type[o];
+        fc.contact.wall_radius = radius[o];
         // a kinematic obstacle (moved by fix move or another fix): its velocity at the point
         const fibre::Vec3 vo(v[o][0], v[o][1], v[o][2]), wo(omega[o][0], omega[o][1], omega[o][2]);
         const fibre::Vec3 xo(x[o][0], x[o][1], x[o][2]);

@@ -7,7 +7,7 @@ namespace fibre {
 double effective_radius(const std::vector<Body> &bodies, const Contact &c)
 {
   const double ra = bodies[c.a].radius;
-  if (c.is_wall()) return ra;
+  if (c.is_wall()) return c.wall_radius > 0 ? effective_radius(ra, &c.wall_radius) : ra;
   return effective_radius(ra, &bodies[c.b].radius);
 }
 

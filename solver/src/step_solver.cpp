@@ -293,7 +293,7 @@ void StepSolver::finish(Vector &lambda, StepResult &res) const
                                : pgs(sys_, ex_, cones_, b_full_, scale, lambda, control);
       res.sweeps += pr.sweeps;
       res.sweep_reason = pr.reason;
-      res.error_estimate = pr.error_estimate();
+      res.error_estimate = pr.reported_estimate();
       res.complementarity = complementarity(sys_, ex_, cones_, b_full_, lambda, scale);
     };
     sweep();

@@ -23,7 +23,9 @@ constexpr int kContactFieldsV2 = kContactFieldsV1 + 3; // + mu, mu_roll, mu_twis
 constexpr int kContactFieldsV3 = kContactFieldsV2 + 8;
 // version 4: + the elastic rows (a bit per row 1..5) and their springs (rows 1..5)
 // version 5: the same, with bit 5 for an elastic normal row (the material's spring)
-constexpr int kContactFields = kContactFieldsV3 + kMaxRows;
+constexpr int kContactFieldsV5 = kContactFieldsV3 + kMaxRows;
+// version 6: + an obstacle sphere's radius (0 for a flat or region wall)
+constexpr int kContactFields = kContactFieldsV5 + 1;
 // Unit vectors must read back as unit vectors; exported data are far more exact than this.
 constexpr double kUnitTol = 1e-6;
 
@@ -239,6 +241,8 @@ void write_system(std::ostream &out, const ContactSystem &sys)
       s += ' ';
       put_real(s, c.spring[r]);
     }
+    s += ' ';
+    put_real(s, c.wall_radius);
     s += '\n';
     out << s;
   }
@@ -279,6 +283,7 @@ ContactSystem parse_system(std::string_view text)
   const int contact_fields = version == 1   ? kContactFieldsV1
                              : version == 2 ? kContactFieldsV2
                              : version == 3 ? kContactFieldsV3
+                             : version <= 5 ? kContactFieldsV5
                                             : kContactFields;
 
   in.keyword(t, "rows", 1, "rows <3|6>");
@@ -395,6 +400,10 @@ ContactSystem parse_system(std::string_view text)
       if (!k.elastic[r] && k.spring[r] != 0)
         in.fail(what + ": a spring on row " + std::to_string(r) + ", which is not elastic");
     }
+    if (version <= 5) continue;
+    k.wall_radius = in.real(t[kContactFieldsV5], what + " wall radius");
+    if (!(k.wall_radius >= 0) || (!k.is_wall() && k.wall_radius != 0))
+      in.fail(what + ": the wall radius must be >= 0, and 0 for a pair");
   }
 
   const long long dofs = rows * nc;

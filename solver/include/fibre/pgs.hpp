@@ -4,6 +4,8 @@
 // residual and is projected; the body velocities follow every update.
 #pragma once
 
+#include <algorithm>
+#include <cmath>
 #include <vector>
 
 #include "fibre/cones.hpp"
@@ -30,7 +32,8 @@ struct PgsControl {
   bool fibre_blocks = false;
   EdgeWeight block_weight = EdgeWeight::impulse;
   double accuracy = 0; // the error-estimate rule (0: off)
-  // The error-estimate rule stops no sooner than this (a sweep that changes nothing stops).
+  // The error-estimate rule stops no sooner than this: a rule met before stops the sweeps
+  // here (and a sweep that changes nothing at once).
   int min_sweeps = 0;
 };
 
@@ -49,6 +52,11 @@ struct PgsResult {
   // One more sweep's change: last_change, changes and contraction follow.
   void record(double change);
   double error_estimate() const;
+  // The estimate when the accuracy rule was first met (infinite if never). The sweeps after it
+  // (PgsControl::min_sweeps) only reduce the error, but their changes may fall to round-off,
+  // where the estimate is undefined: the step reports the smaller of the two.
+  double met_estimate = INFINITY;
+  double reported_estimate() const { return std::min(error_estimate(), met_estimate); }
   bool converged() const { return reason == StopReason::converged; }
 };
 

@@ -65,6 +65,10 @@ struct Contact {
   // (zero for walls at rest). They enter the rhs as the velocity of body b (spook_rhs).
   Vec3 wall_v = Vec3::Zero();
   Vec3 wall_omega = Vec3::Zero();
+  // An obstacle sphere's radius (an atom outside the fix's group), 0 for a flat or region
+  // wall: the effective radius of the contact's Hertz, rolling and twisting laws is
+  // ra wall_radius / (ra + wall_radius), as the pair style's between the two atoms.
+  double wall_radius = 0.0;
   // Elastic rows (compliance material): a row whose compliance is the law's spring carries
   // its displacement at the step's start, in the contact frame, in the rhs as the normal row
   // carries the gap: rows 1, 2 the tangential displacement (length), 3 the twisting and 4, 5

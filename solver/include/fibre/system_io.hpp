@@ -33,7 +33,7 @@
 namespace fibre {
 
 // 2: friction per contact; 3: restitution per contact and the bounce speed. 1 and 2 are read.
-inline constexpr int kSystemFormatVersion = 5;
+inline constexpr int kSystemFormatVersion = 6;
 
 void write_system(std::ostream &out, const ContactSystem &sys);
 // Throws std::runtime_error when the file cannot be written.
