@@ -96,7 +96,6 @@ PgsResult pgs(const ContactSystem &sys, const Exchange &ex, const Cones &cones, 
   Vector lambda_start;
   double best = INFINITY;
   int since_best = 0;
-  bool met_accuracy = false;
   Vector direction, change; // nonlinear CG
   double last_change2 = 0;
   std::unique_ptr<FibreBlocks> blocks;
@@ -135,13 +134,12 @@ PgsResult pgs(const ContactSystem &sys, const Exchange &ex, const Cones &cones, 
     res.reason = StopReason::max_iterations;
     // with a floor, a met estimate stops the sweeps at the floor: the changes of the sweeps
     // after it may fall to round-off, where the estimated rate means nothing
-    if (!met_accuracy && res.error_estimate() <= control.accuracy) {
-      met_accuracy = true;
+    if (control.accuracy > 0 && !(res.met_estimate <= control.accuracy) &&
+        res.error_estimate() <= control.accuracy)
       res.met_estimate = res.error_estimate();
-    }
-    const bool done = control.accuracy > 0
-                          ? met_accuracy && (res.sweeps >= control.min_sweeps || norms[0] == 0)
-                          : !(norms[0] > control.tol * control.tol * norms[1]);
+    const bool done = control.accuracy > 0 ? res.met_estimate <= control.accuracy &&
+                                                 (res.sweeps >= control.min_sweeps || norms[0] == 0)
+                                           : !(norms[0] > control.tol * control.tol * norms[1]);
     if (done) {
       res.reason = StopReason::converged;
       break;
