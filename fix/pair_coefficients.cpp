@@ -103,6 +103,8 @@ void read_granular(const std::string &bytes, int ntypes, PairReading &out)
       p.k_t = tangential[0];
       p.k_roll = model[3] == 1 ? roll[0] : 0.0;
       p.k_twist = model[4] == 1 ? twist[0] : 0.0;
+      p.gamma_roll = model[3] == 1 ? roll[1] : 0.0;
+      p.gamma_twist = model[4] == 1 ? twist[1] : 0.0;
       // the rebound LAMMPS's own law gives (dmt and jkr: their Hertz part)
       if (model[1] == kTsuji) {
         p.damping_alpha = normal[1];
@@ -128,8 +130,9 @@ void read_granular(const std::string &bytes, int ntypes, PairReading &out)
   }
   out.notes.push_back("the stiffnesses of pair_coeff (normal, tangential, rolling and twisting "
                       "sds) set the rows' compliance ('compliance material', the default here; "
-                      "'compliance auto' makes the rows rigid); the damping coefficients are not "
-                      "used (SPOOK's damping, and e for bounces)");
+                      "'compliance auto' makes the rows rigid), and the rolling and twisting sds "
+                      "dampers their springs' damping; the normal and tangential damping "
+                      "coefficients are not used (SPOOK's damping, and e for bounces)");
   if (cohesion) out.notes.push_back("the cohesion of dmt and jkr is not modelled");
   out.table = std::move(table);
   out.material = true;

@@ -89,11 +89,12 @@ Vector assemble_rhs(const ContactSystem &sys)
     const Eigen::Index row = Eigen::Index(sys.rows()) * c;
     const double ups_c = p.upsilon(p.damping_of(k));
     const std::array<double, kMaxRows> wall = wall_rows(k);
-    for (int r = 0; r < sys.rows(); ++r)
-      rhs[row + r] += (ups_c - ups) * Gv[row + r] + (1.0 - ups_c) * wall[r];
-    for (int r = 1; r < sys.rows(); ++r)
-      if (k.elastic[r] && sys.row_active(row + r))
-        rhs[row + r] += p.spring_term(k.spring[r], ups_c);
+    for (int r = 0; r < sys.rows(); ++r) {
+      const double ups_r = p.upsilon(p.damping_of(k, r));
+      rhs[row + r] += (ups_r - ups) * Gv[row + r] + (1.0 - ups_r) * wall[r];
+      if (r > 0 && k.elastic[r] && sys.row_active(row + r))
+        rhs[row + r] += p.spring_term(k.spring[r], ups_r);
+    }
     if (sys.row_active(row)) rhs[row] += p.gap_term(k.gap, ups_c, k.elastic[0]);
   }
   return rhs;

@@ -44,6 +44,13 @@ void apply_pair(const ContactModel &model, const PairCoefficients &pc, double h,
   const double m_eff = c.is_wall() ? ma : ma * bodies[c.b].mass / (ma + bodies[c.b].mass);
   const double critical = 2.0 * std::sqrt(m_eff * c.compliance[0]) / h;
   if (critical > model.damping) c.damping = critical;
+  // The rolling and twisting springs carry the law's own damper, not the contact's critical
+  // damping: SPOOK's damping time is the Kelvin-Voigt element's gamma / k. SPOOK's d is the
+  // floor (below two steps a spring stiffer than the step rings; doc/design.md section 2).
+  for (int r = 3; r < rows; ++r) {
+    const double tau = spring_damping_time(pc, r);
+    if (c.elastic[r] && tau > 0) c.spring_damping[r] = std::max(model.damping, tau / h);
+  }
 }
 
 } // namespace
@@ -64,6 +71,7 @@ void apply_contact_model(const ContactModel &model, double h, double m_min,
     c.friction = model.friction;
     c.restitution = model.restitution;
     c.elastic.fill(false);
+    c.spring_damping.fill(-1.0);
     const int ta = bodies[c.a].type;
     const int tb = !c.is_wall() ? bodies[c.b].type : c.wall_type > 0 ? c.wall_type : ta;
     const int ntypes = model.materials.ntypes();

@@ -56,6 +56,8 @@ std::string MaterialTable::mix()
       p.k_t = stiff(a.k_t, b.k_t);
       p.k_roll = geom(a.k_roll, b.k_roll);
       p.k_twist = geom(a.k_twist, b.k_twist);
+      p.gamma_roll = geom(a.gamma_roll, b.gamma_roll);
+      p.gamma_twist = geom(a.gamma_twist, b.gamma_twist);
       // LAMMPS mixes Tsuji's alpha; the rebound then follows from the mixed law
       p.limit_damping = a.limit_damping || b.limit_damping;
       if (a.damping_alpha >= 0 && b.damping_alpha >= 0) {
@@ -148,7 +150,21 @@ bool material_compliance(const PairCoefficients &p, double r_eff, double overlap
   const double d_now = std::max(overlap, 0.0);
   const double f_now = hertz ? p.k_n * std::sqrt(r_eff * d_now) * d_now : p.k_n * d_now;
   const double f = std::max(last_force, f_now);
-  if (!(f > 0)) return true; // unloaded: rigid until it carries load
+  const double k_roll = p.k_roll * r_eff * r_eff; // torque per unit angle
+  if (!(f > 0)) {                                 // unloaded: the load-free springs only
+    const double free[kMaxRows] = {0.0,
+                                   p.tangential == TangentialLaw::linear ? p.k_t : 0.0,
+                                   p.tangential == TangentialLaw::linear ? p.k_t : 0.0,
+                                   p.twist == TwistLaw::sds ? p.k_twist : 0.0,
+                                   k_roll,
+                                   k_roll};
+    for (int r = 1; r < kMaxRows; ++r)
+      if (free[r] > 0) {
+        eps[r] = 1.0 / free[r];
+        elastic[r] = true;
+      }
+    return true;
+  }
   // the law's overlap at the reference load, and its contact radius
   const double d = hertz ? std::cbrt(f * f / (p.k_n * p.k_n * r_eff)) : f / p.k_n;
   eps[0] = d / f;
@@ -161,7 +177,6 @@ bool material_compliance(const PairCoefficients &p, double r_eff, double overlap
   const double k_twist = p.twist == TwistLaw::marshall ? 0.5 * k_t * a * a
                          : p.twist == TwistLaw::sds    ? p.k_twist
                                                        : 0.0;
-  const double k_roll = p.k_roll * r_eff * r_eff; // torque per unit angle
   const double stiffness[kMaxRows] = {0.0, k_t, k_t, k_twist, k_roll, k_roll};
   for (int r = 1; r < kMaxRows; ++r)
     if (stiffness[r] > 0) {
@@ -169,6 +184,14 @@ bool material_compliance(const PairCoefficients &p, double r_eff, double overlap
       elastic[r] = true;
     }
   return true;
+}
+
+double spring_damping_time(const PairCoefficients &p, int r)
+{
+  if ((r == 4 || r == 5) && p.k_roll > 0 && p.gamma_roll > 0) return p.gamma_roll / p.k_roll;
+  if (r == 3 && p.twist == TwistLaw::sds && p.k_twist > 0 && p.gamma_twist > 0)
+    return p.gamma_twist / p.k_twist;
+  return 0.0;
 }
 
 std::vector<std::string> MaterialTable::describe() const

@@ -41,7 +41,7 @@ Vector spook_rhs(const ContactSystem &sys, const Vector *extra_dv)
   // G v, where a contact bounces or has its own damping
   Vector Gv;
   for (const Contact &k : sys.contacts())
-    if (k.restitution > 0 || k.damping >= 0 || k.wall_moves()) {
+    if (k.restitution > 0 || k.own_damping() || k.wall_moves()) {
       g_apply(sys, v, Gv);
       break;
     }
@@ -50,15 +50,17 @@ Vector spook_rhs(const ContactSystem &sys, const Vector *extra_dv)
     const Contact &k = sys.contacts()[c];
     const Eigen::Index row = Eigen::Index(rows) * c; // normal row
     const double ups_c = p.upsilon(p.damping_of(k));
-    if (k.damping >= 0) // -(1 - Upsilon_c) G v on every row of the contact
-      for (int r = 0; r < rows; ++r) b[row + r] += (ups_c - ups) * Gv[row + r];
+    if (k.own_damping()) // -(1 - Upsilon_r) G v on every row of the contact
+      for (int r = 0; r < rows; ++r)
+        b[row + r] += (p.upsilon(p.damping_of(k, r)) - ups) * Gv[row + r];
     // A moving wall is body b with a prescribed velocity, the same after the step:
     // -(1 - Upsilon) G v of the relative velocity, G_b w_b = -wall_rows.
     const std::array<double, kMaxRows> wall = wall_rows(k);
     if (k.wall_moves())
-      for (int r = 0; r < rows; ++r) b[row + r] += (1.0 - ups_c) * wall[r];
+      for (int r = 0; r < rows; ++r) b[row + r] += (1.0 - p.upsilon(p.damping_of(k, r))) * wall[r];
     for (int r = 1; r < rows; ++r)
-      if (k.elastic[r] && sys.row_active(row + r)) b[row + r] += p.spring_term(k.spring[r], ups_c);
+      if (k.elastic[r] && sys.row_active(row + r))
+        b[row + r] += p.spring_term(k.spring[r], p.upsilon(p.damping_of(k, r)));
     if (!sys.row_active(row)) continue;
     const double b_spook = b[row] + p.gap_term(k.gap, ups_c, k.elastic[0]);
     // Row: G_n v+ + eps lambda_n = G_n (v + h M^-1 f) + b_n, so b_n = 0 is free flight and
@@ -75,6 +77,12 @@ Vector spook_rhs(const ContactSystem &sys, const Vector *extra_dv)
           sys.inv_mass()[kBodyDofs * k.a] + (k.is_wall() ? 0.0 : sys.inv_mass()[kBodyDofs * k.b]);
       const double jump = (b[row] - (ups_c + k.restitution) * vn) * (1.0 + sys.sigma()[row] / w_nn);
       b[row] = std::max(b_spook, jump);
+      // The impact's rigid rows stick within the step where their cones allow (Newton's law
+      // with Coulomb friction, no tangential restitution): SPOOK's damping would leave Upsilon
+      // of the slip, and the contact opens before a later step removes it.
+      for (int r = 1; r < rows; ++r)
+        if (!k.elastic[r] && sys.row_active(row + r))
+          b[row + r] -= p.upsilon(p.damping_of(k, r)) * (Gv[row + r] - wall[r]);
     } else if (bounces && k.gap > 0) {
       // Free flight, but not through the contact within the step when other contacts stop
       // the partner: G_n v+ >= -gap / h.

@@ -116,10 +116,10 @@ void ContactSystem::compute_rows()
 {
   for (int c = 0; c < num_contacts(); ++c) {
     const Contact &k = contacts_[c];
-    const double d = params_.damping_of(k);
     for (int r = 0; r < rows_; ++r) {
       const Eigen::Index row = Eigen::Index(rows_) * c + r;
-      sigma_[row] = row_active(row) ? params_.sigma(k.compliance[r], d) : 1.0;
+      sigma_[row] =
+          row_active(row) ? params_.sigma(k.compliance[r], params_.damping_of(k, r)) : 1.0;
     }
   }
   inv_sigma_ = sigma_.cwiseInverse();

@@ -25,7 +25,9 @@ constexpr int kContactFieldsV3 = kContactFieldsV2 + 8;
 // version 5: the same, with bit 5 for an elastic normal row (the material's spring)
 constexpr int kContactFieldsV5 = kContactFieldsV3 + kMaxRows;
 // version 6: + an obstacle sphere's radius (0 for a flat or region wall)
-constexpr int kContactFields = kContactFieldsV5 + 1;
+constexpr int kContactFieldsV6 = kContactFieldsV5 + 1;
+// version 7: + the springs' own damping (rows 1..5, -1 for the contact's)
+constexpr int kContactFields = kContactFieldsV6 + kMaxRows - 1;
 // Unit vectors must read back as unit vectors; exported data are far more exact than this.
 constexpr double kUnitTol = 1e-6;
 
@@ -243,6 +245,10 @@ void write_system(std::ostream &out, const ContactSystem &sys)
     }
     s += ' ';
     put_real(s, c.wall_radius);
+    for (int r = 1; r < kMaxRows; ++r) {
+      s += ' ';
+      put_real(s, c.spring_damping[r]);
+    }
     s += '\n';
     out << s;
   }
@@ -284,6 +290,7 @@ ContactSystem parse_system(std::string_view text)
                              : version == 2 ? kContactFieldsV2
                              : version == 3 ? kContactFieldsV3
                              : version <= 5 ? kContactFieldsV5
+                             : version == 6 ? kContactFieldsV6
                                             : kContactFields;
 
   in.keyword(t, "rows", 1, "rows <3|6>");
@@ -404,6 +411,13 @@ ContactSystem parse_system(std::string_view text)
     k.wall_radius = in.real(t[kContactFieldsV5], what + " wall radius");
     if (!(k.wall_radius >= 0) || (!k.is_wall() && k.wall_radius != 0))
       in.fail(what + ": the wall radius must be >= 0, and 0 for a pair");
+    if (version <= 6) continue;
+    for (int r = 1; r < kMaxRows; ++r) {
+      const double d = in.real(t[kContactFieldsV6 + r - 1], what + " spring damping");
+      if (!(d >= 0 || d == -1))
+        in.fail(what + ": a spring's damping must be non-negative, or -1 for the contact's");
+      k.spring_damping[r] = d;
+    }
   }
 
   const long long dofs = rows * nc;

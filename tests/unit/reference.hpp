@@ -65,10 +65,13 @@ inline Eigen::VectorXd dense_sigma(const ContactSystem &sys)
   const SpookParams &p = sys.params();
   for (int c = 0; c < sys.num_contacts(); ++c)
     for (int r = 0; r < sys.rows(); ++r) {
+      const Contact &k = sys.contacts()[c];
+      // the row's own damping, else the contact's, else the system's
+      const double d = r > 0 && k.spring_damping[r] >= 0 ? k.spring_damping[r]
+                       : k.damping >= 0                  ? k.damping
+                                                         : p.damping;
       const Eigen::Index row = Eigen::Index(sys.rows()) * c + r;
-      s[row] = sys.row_active(row)
-                   ? 4.0 * sys.contacts()[c].compliance[r] / (p.h * p.h * (1.0 + 4.0 * p.damping))
-                   : 1.0;
+      s[row] = sys.row_active(row) ? 4.0 * k.compliance[r] / (p.h * p.h * (1.0 + 4.0 * d)) : 1.0;
     }
   return s;
 }

@@ -156,6 +156,8 @@ TEST(Material, ApplyContactModelPerType)
   EXPECT_DOUBLE_EQ(contacts[3].friction.mu, 0.4);
   EXPECT_DOUBLE_EQ(contacts[0].restitution, 0.3);
   EXPECT_DOUBLE_EQ(contacts[2].restitution, 0.0); // plastic: the model's default
+  for (const Contact &c : contacts) // no springs (compliance auto): no dampers of their own
+    EXPECT_EQ(c.spring_damping, (std::array<double, kMaxRows>{-1, -1, -1, -1, -1, -1}));
   EXPECT_DOUBLE_EQ(contacts[1].restitution, 0.0); // mixing with "none" gives none
   // a contact loaded in the last step endures: no restitution; an unloaded one is an impact
   Vector last = Vector::Zero(6 * 4);
@@ -226,7 +228,8 @@ TEST(Material, SecantComplianceOfTheNormalLaw)
 
 // The springs: Mindlin k_t a, SDS rolling k_roll r_eff^2 per angle, Marshall twisting
 // 0.5 k_t a^2 (k_t a), each at the contact radius a = sqrt(r_eff d) of the reference load's
-// overlap d; unloaded contacts stay rigid.
+// overlap d. Unloaded contacts keep rigid normal, Mindlin and Marshall rows; the load-free
+// springs (linear tangential, SDS rolling and twisting) are elastic from the first step.
 TEST(Material, SpringsOfTheTangentialRollingAndTwistingLaws)
 {
   PairCoefficients p = hertz_material_pair();
@@ -254,12 +257,44 @@ TEST(Material, SpringsOfTheTangentialRollingAndTwistingLaws)
   material_compliance(p, r_eff, 0.0, load, rigid, eps, elastic);
   EXPECT_DOUBLE_EQ(eps[1], 1.0 / p.k_t);
   EXPECT_DOUBLE_EQ(eps[3], 1.0 / 3.0);
-  // unloaded: every row rigid, none elastic
+  // unloaded: the normal row rigid, the load-free springs as loaded
   material_compliance(p, r_eff, 0.0, 0.0, rigid, eps, elastic);
-  for (int r = 0; r < kMaxRows; ++r) {
-    EXPECT_FALSE(elastic[r]);
-    EXPECT_EQ(eps[r], rigid[r]);
+  EXPECT_FALSE(elastic[0]);
+  EXPECT_EQ(eps[0], rigid[0]);
+  for (int r = 1; r < kMaxRows; ++r) EXPECT_TRUE(elastic[r]) << r;
+  EXPECT_DOUBLE_EQ(eps[1], 1.0 / p.k_t);
+  EXPECT_DOUBLE_EQ(eps[3], 1.0 / 3.0);
+  EXPECT_NEAR(eps[4], 1.0 / (p.k_roll * r_eff * r_eff), 1e-14);
+  // unloaded Mindlin and Marshall: no contact radius, no spring; rolling sds still elastic
+  p.tangential = TangentialLaw::mindlin;
+  p.twist = TwistLaw::marshall;
+  material_compliance(p, r_eff, 0.0, 0.0, rigid, eps, elastic);
+  for (int r = 0; r < 4; ++r) {
+    EXPECT_FALSE(elastic[r]) << r;
+    EXPECT_EQ(eps[r], rigid[r]) << r;
   }
+  EXPECT_TRUE(elastic[4] && elastic[5]);
+  EXPECT_NEAR(eps[5], 1.0 / (p.k_roll * r_eff * r_eff), 1e-14);
+}
+
+// SDS's damper is the spring's own damping time gamma / k (a Kelvin-Voigt element); the other
+// laws have none of their own.
+TEST(Material, SdsDampersGiveTheSpringsTheirDampingTime)
+{
+  PairCoefficients p = hertz_material_pair();
+  p.k_roll = 1e3;
+  p.gamma_roll = 10.0;
+  p.twist = TwistLaw::sds;
+  p.k_twist = 4.0;
+  p.gamma_twist = 0.5;
+  EXPECT_DOUBLE_EQ(spring_damping_time(p, 4), 1e-2);
+  EXPECT_DOUBLE_EQ(spring_damping_time(p, 5), 1e-2);
+  EXPECT_DOUBLE_EQ(spring_damping_time(p, 3), 0.125);
+  for (int r : {0, 1, 2}) EXPECT_EQ(spring_damping_time(p, r), 0.0);
+  p.twist = TwistLaw::marshall; // its damping is the tangential one's, not modelled
+  EXPECT_EQ(spring_damping_time(p, 3), 0.0);
+  p.gamma_roll = 0.0;
+  EXPECT_EQ(spring_damping_time(p, 4), 0.0);
 }
 
 // Unlike hertz/material types mix by the harmonic mean of the stored 4/3 E_eff (LAMMPS mixes E
@@ -278,4 +313,46 @@ TEST(Material, HertzMaterialStiffnessMixesLikeEAndNu)
   ASSERT_EQ(t.mix(), "");
   const double e_eff = 1.0 / ((1 - 0.09) / 1e5 + (1 - 0.04) / 4e5);
   EXPECT_NEAR(t.at(1, 2).k_n, 4.0 / 3.0 * e_eff, 1e-9 * e_eff);
+}
+
+// compliance material on a new contact and a loaded one: the SDS rolling rows are elastic from
+// the first step and carry the damping time gamma / k in steps (SPOOK's d as a floor); the
+// normal row takes the contact's damping.
+TEST(Material, RollingSpringsCarryTheirDamperFromTheFirstStep)
+{
+  std::vector<Body> bodies(2);
+  bodies[1].x = Vec3(1.0, 0, 0);
+  for (Body &b : bodies) b.type = 1;
+  std::vector<Contact> contacts(2);
+  contacts[0].a = 0; // a pair, touching, no load yet
+  contacts[0].b = 1;
+  contacts[1].a = 1; // a wall contact, loaded in the last step
+  contacts[1].gap = -1e-4;
+  ContactModel model;
+  model.compliance.automatic = false;
+  model.compliance.material = true;
+  model.materials = MaterialTable(1);
+  PairCoefficients p = hertz_material_pair();
+  p.set = true;
+  p.tangential = TangentialLaw::mindlin;
+  p.k_t = 5.1e4;
+  p.k_roll = 1e3;
+  p.gamma_roll = 10.0;
+  model.materials.at(1, 1) = p;
+  Vector last = Vector::Zero(12);
+  last[6] = 1e-3;
+  for (const double h : {1e-3, 1e-4}) {
+    apply_contact_model(model, h, 1.0, bodies, contacts, &last);
+    for (const Contact &c : contacts) {
+      EXPECT_TRUE(c.elastic[4] && c.elastic[5]);
+      EXPECT_DOUBLE_EQ(c.spring_damping[4], std::max(model.damping, 1e-2 / h));
+      EXPECT_EQ(c.spring_damping[5], c.spring_damping[4]);
+      for (int r : {0, 1, 2, 3}) EXPECT_EQ(c.spring_damping[r], -1.0) << r;
+    }
+    EXPECT_FALSE(contacts[0].elastic[0] || contacts[0].elastic[1]); // no load: no Hertz, Mindlin
+    EXPECT_TRUE(contacts[1].elastic[0] && contacts[1].elastic[1]);
+  }
+  // the floor: a damper faster than two steps is SPOOK's two steps
+  apply_contact_model(model, 1e-1, 1.0, bodies, contacts, &last);
+  EXPECT_DOUBLE_EQ(contacts[0].spring_damping[4], model.damping);
 }

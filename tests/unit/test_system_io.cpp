@@ -37,6 +37,7 @@ ContactSystem sample_system(int rows = 6)
   contacts[1].restitution = 0.7;                               // since version 3
   contacts[2].elastic = {true, true, true, false, true, true}; // since version 4 (5: row 0)
   contacts[2].spring = {0.0, 1.0 / 3.0, -2e-7, 0.0, 1e-300, -0.5};
+  contacts[2].spring_damping = {-1.0, -1.0, -1.0, 0.0, 56.8, 56.8}; // since version 7
   for (Contact &c : contacts) // an obstacle sphere, since version 6
     if (c.is_wall()) {
       c.wall_radius = 0.375;
@@ -89,7 +90,8 @@ void expect_identical(const ContactSystem &a, const ContactSystem &b)
                 p.friction.mu_roll == q.friction.mu_roll &&
                 p.friction.mu_twist == q.friction.mu_twist && p.restitution == q.restitution &&
                 p.damping == q.damping && p.wall_v == q.wall_v && p.wall_omega == q.wall_omega &&
-                p.elastic == q.elastic && p.spring == q.spring && p.wall_radius == q.wall_radius)
+                p.elastic == q.elastic && p.spring == q.spring && p.wall_radius == q.wall_radius &&
+                p.spring_damping == q.spring_damping)
         << "contact " << c;
   }
   EXPECT_EQ(a.row_mask(), b.row_mask());
@@ -160,7 +162,7 @@ TEST(SystemIo, RoundTripIsExact)
   for (int rows : {6, 3}) {
     const ContactSystem sys = sample_system(rows);
     const std::string text = to_text(sys);
-    EXPECT_EQ(text.rfind("fibre_contact_system 6\n", 0), 0u);
+    EXPECT_EQ(text.rfind("fibre_contact_system 7\n", 0), 0u);
     const ContactSystem back = parse_system(text);
     expect_identical(sys, back);
     EXPECT_EQ(to_text(back), text); // and the writer is deterministic
@@ -190,7 +192,7 @@ std::string older_version(const ContactSystem &sys, int version, int drop_spook,
     }
     out += line + "\n";
   }
-  out.replace(0, std::string("fibre_contact_system 6").size(),
+  out.replace(0, std::string("fibre_contact_system 7").size(),
               "fibre_contact_system " + std::to_string(version));
   return out;
 }
@@ -200,24 +202,24 @@ std::string older_version(const ContactSystem &sys, int version, int drop_spook,
 TEST(SystemIo, OlderVersionsAndCoefficientFields)
 {
   const ContactSystem sys = sample_system();
-  const ContactSystem v1 = parse_system(older_version(sys, 1, 2, 18));
+  const ContactSystem v1 = parse_system(older_version(sys, 1, 2, 23));
   ASSERT_EQ(v1.num_contacts(), sys.num_contacts());
   EXPECT_EQ(v1.contacts()[1].friction.mu, FrictionParams{}.mu);
   EXPECT_EQ(v1.contacts()[1].friction.mu_roll, FrictionParams{}.mu_roll);
   EXPECT_EQ(v1.contacts()[1].restitution, 0.0);
   EXPECT_EQ(v1.contacts()[0].compliance, sys.contacts()[0].compliance);
   EXPECT_EQ(v1.params().max_recovery, 0.0);
-  const ContactSystem v2 = parse_system(older_version(sys, 2, 1, 15));
+  const ContactSystem v2 = parse_system(older_version(sys, 2, 1, 20));
   EXPECT_EQ(v2.contacts()[1].friction.mu, 0.3);
   EXPECT_EQ(v2.contacts()[1].restitution, 0.0);
   EXPECT_EQ(v2.params().max_recovery, 0.125);
   EXPECT_EQ(v2.params().bounce_speed, 0.0);
-  const ContactSystem v3 = parse_system(older_version(sys, 3, 0, 7));
+  const ContactSystem v3 = parse_system(older_version(sys, 3, 0, 12));
   EXPECT_EQ(v3.contacts()[1].restitution, 0.7);
   EXPECT_FALSE(v3.contacts()[2].any_elastic());
   // version 4 knows the elastic rows 1..5 only: bit 5 (the normal row) is an error there,
   // and without it the normal row reads rigid
-  const std::string v4_text = older_version(sys, 4, 0, 1);
+  const std::string v4_text = older_version(sys, 4, 0, 6);
   expect_error(v4_text, {"contact 2:", "rows 1 to 5, in [0, 31]"});
   const std::size_t mask_at = v4_text.find(" 59 ", v4_text.find("contacts "));
   ASSERT_NE(mask_at, std::string::npos); // contact 2's mask: rows 0, 1, 2, 4, 5
@@ -227,13 +229,18 @@ TEST(SystemIo, OlderVersionsAndCoefficientFields)
   EXPECT_TRUE(v4.contacts()[2].elastic[1]);
   EXPECT_EQ(v3.contacts()[2].spring, (std::array<double, kMaxRows>{}));
   // version 5 has no obstacle radius: every wall reads flat
-  const ContactSystem v5 = parse_system(older_version(sys, 5, 0, 1));
+  const ContactSystem v5 = parse_system(older_version(sys, 5, 0, 6));
   int obstacles = 0;
   for (int c = 0; c < sys.num_contacts(); ++c) {
     obstacles += sys.contacts()[c].wall_radius > 0;
     EXPECT_EQ(v5.contacts()[c].wall_radius, 0.0);
   }
   EXPECT_EQ(obstacles, 1);
+  // version 6 has no springs' own damping: every row takes the contact's
+  const ContactSystem v6 = parse_system(older_version(sys, 6, 0, 5));
+  EXPECT_EQ(v6.contacts()[2].spring_damping,
+            (std::array<double, kMaxRows>{-1, -1, -1, -1, -1, -1}));
+  EXPECT_EQ(v6.contacts()[2].wall_radius, sys.contacts()[2].wall_radius);
   // the first contact line with a negative twisting coefficient, a restitution of 2 and a
   // negative damping other than -1
   const std::string text = to_text(sys);
@@ -242,7 +249,7 @@ TEST(SystemIo, OlderVersionsAndCoefficientFields)
   std::vector<std::string> fields;
   std::istringstream words(text.substr(begin, end - begin));
   for (std::string w; words >> w;) fields.push_back(w);
-  ASSERT_EQ(fields.size(), 39u);
+  ASSERT_EQ(fields.size(), 44u);
   const auto with = [&](std::size_t index, const std::string &value) {
     std::vector<std::string> f = fields;
     f[index] = value;
@@ -258,6 +265,8 @@ TEST(SystemIo, OlderVersionsAndCoefficientFields)
   expect_error(with(33, "0.5"), {"contact 0:", "a spring on row 1, which is not elastic"});
   const Contact elastic = parse_system(with(32, "9")).contacts()[0]; // rows 1 and 4
   EXPECT_TRUE(elastic.elastic[1] && elastic.elastic[4] && !elastic.elastic[2]);
+  expect_error(with(43, "-2"), {"contact 0:", "a spring's damping must be non-negative"});
+  EXPECT_EQ(parse_system(with(43, "3.5")).contacts()[0].spring_damping[5], 3.5);
   if (sys.contacts()[0].is_wall()) return;
   expect_error(with(26, "1"), {"contact 0:", "a pair cannot have a wall velocity"});
 }
@@ -305,7 +314,7 @@ TEST(SystemIo, EachMalformedInputGetsItsOwnError)
 
   expect_error("", {"line 1:", "unexpected end of input", "header"});
   expect_error(edit(0, "fibre_contact_sistem 1"), {"line 1:", "not a fibre_contact system"});
-  expect_error(edit(0, "fibre_contact_system 7"), {"unsupported format version 7"});
+  expect_error(edit(0, "fibre_contact_system 8"), {"unsupported format version 8"});
   expect_error(edit(0, "fibre_contact_system one"), {"'one' is not an integer"});
   expect_error(edit(2, "rows 4"), {"rows must be 3 or 6"});
   expect_error(edit(3, "spook 0 2"), {"time step h must be positive"});
@@ -323,7 +332,7 @@ TEST(SystemIo, EachMalformedInputGetsItsOwnError)
     const std::string cut = join(std::vector<std::string>(L.begin(), L.begin() + last)) +
                             L[last].substr(0, L[last].size() / 2);
     expect_error(cut, {line_tag(last), "contact " + std::to_string(sys.num_contacts() - 1) +
-                                           ": expected 39 values"});
+                                           ": expected 44 values"});
     expect_error(text.substr(0, text.size() - 4), {"unexpected end of input", "'end'"});
     std::vector<std::string> early(L.begin(), L.begin() + bodies + 3);
     expect_error(join(early), {line_tag(bodies), "body count 25 is more than the rest"});
@@ -366,7 +375,7 @@ TEST(SystemIo, EachMalformedInputGetsItsOwnError)
   expect_error(edit(contacts + 1, with_token(c0, 2, "2")), {"contact 0 normal is not a unit"});
   expect_error(edit(contacts + 1, with_token(c0, 15, "0")),
                {"contact 0: compliance of row 0 must be positive"});
-  expect_error(edit(contacts + 1, c0 + " 7"), {"contact 0: expected 39 values, found 40"});
+  expect_error(edit(contacts + 1, c0 + " 7"), {"contact 0: expected 44 values, found 45"});
 
   // Anything after the end, and binary junk.
   expect_error(text + "bodies 1 1\n", {"unexpected content after 'end'"});

@@ -46,6 +46,10 @@ struct PairCoefficients {
   double k_t = 0.0;
   double k_roll = 0.0;  // rolling sds, 0: none
   double k_twist = 0.0; // twisting sds
+  // The SDS dampers (LAMMPS's gamma_roll, gamma_twist): with the spring a Kelvin-Voigt
+  // element of damping time gamma / k (spring_damping_time).
+  double gamma_roll = 0.0;
+  double gamma_twist = 0.0;
 };
 
 // Symmetric table over types 1..ntypes.
@@ -94,11 +98,18 @@ FrictionParams contact_friction(const PairCoefficients &p, double r_eff, double 
 // under a steady load overlaps by the law's d(F) and a native state at equilibrium is one here
 // too; it is marked `elastic` (its gap term is the law's force, not bounded). Tangential, twisting
 // and rolling rows: 1 / the law's spring at the contact radius a of d(F), marked `elastic` (they
-// carry their displacement in the rhs, Contact::spring). Rows without a spring, and every row of a
-// contact with F = 0 (new, not overlapping), keep `rigid` (the automatic compliance). Returns false
-// when p has no normal law.
+// carry their displacement in the rhs, Contact::spring). Rows without a spring keep `rigid` (the
+// automatic compliance). A contact with F = 0 (new, not overlapping) keeps `rigid` on its normal
+// and Mindlin rows, whose laws need a load; the load-free springs (linear tangential, SDS rolling
+// and twisting) are elastic from its first step, as the pair style's are from the first touch:
+// an impact cannot load a soft spring within the collision. Returns false when p has no normal
+// law.
 bool material_compliance(const PairCoefficients &p, double r_eff, double overlap, double last_force,
                          const std::array<double, kMaxRows> &rigid,
                          std::array<double, kMaxRows> &eps, std::array<bool, kMaxRows> &elastic);
+
+// The damping time (seconds) of row r's spring in the pair's law, gamma / k of the SDS rolling
+// (rows 4, 5) and twisting (row 3) laws; 0 where the law has no damper of its own.
+double spring_damping_time(const PairCoefficients &p, int r);
 
 } // namespace fibre

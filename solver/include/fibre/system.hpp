@@ -77,6 +77,17 @@ struct Contact {
   // overlap is the load's, not an error, so max_recovery does not bound it.
   std::array<bool, kMaxRows> elastic{};
   std::array<double, kMaxRows> spring{};
+  // An elastic row's own SPOOK damping d (steps), or < 0 for the contact's: the pair style's
+  // rolling and twisting dampers (a spring and a damper are SPOOK's compliance and damping
+  // time). Rows 1..5; row 0 takes the contact's.
+  std::array<double, kMaxRows> spring_damping{-1.0, -1.0, -1.0, -1.0, -1.0, -1.0};
+  // Whether some row is damped otherwise than the system's SpookParams::damping.
+  bool own_damping() const
+  {
+    bool own = damping >= 0;
+    for (double d : spring_damping) own = own || d >= 0;
+    return own;
+  }
   bool any_elastic() const
   {
     for (bool e : elastic)
@@ -130,6 +141,11 @@ struct SpookParams {
   double bounce_speed = 0.0;
   // A contact's damping: its own when set (Contact::damping >= 0), else the system's.
   double damping_of(const Contact &c) const { return c.damping >= 0 ? c.damping : damping; }
+  // Row r's: its spring's own (Contact::spring_damping) where it has one, else the contact's.
+  double damping_of(const Contact &c, int r) const
+  {
+    return r > 0 && c.spring_damping[r] >= 0 ? c.spring_damping[r] : damping_of(c);
+  }
   // The gap term of the normal row's rhs, -(4 / h) Upsilon g, bounded by max_recovery unless
   // the row is the material's spring (Contact::elastic[0]): bounding an elastic overlap would
   // bound the force the contact can carry, and a wedged sphere would stay deep in.

@@ -32,8 +32,10 @@
 
 namespace fibre {
 
-// 2: friction per contact; 3: restitution per contact and the bounce speed. 1 and 2 are read.
-inline constexpr int kSystemFormatVersion = 6;
+// 2: friction per contact; 3: restitution, damping and wall velocity per contact and the bounce
+// speed; 4, 5: elastic rows and their springs; 6: an obstacle's radius; 7: the springs' own
+// damping. Every older version is read (doc/system_format.md).
+inline constexpr int kSystemFormatVersion = 7;
 
 void write_system(std::ostream &out, const ContactSystem &sys);
 // Throws std::runtime_error when the file cannot be written.
