@@ -151,7 +151,8 @@ bool material_compliance(const PairCoefficients &p, double r_eff, double overlap
   const double f_now = hertz ? p.k_n * std::sqrt(r_eff * d_now) * d_now : p.k_n * d_now;
   const double f = std::max(last_force, f_now);
   const double k_roll = p.k_roll * r_eff * r_eff; // torque per unit angle
-  if (!(f > 0)) {                                 // unloaded: the load-free springs only
+  // unloaded: the load-free springs only
+  if (!(f > 0)) {
     const double free[kMaxRows] = {0.0,
                                    p.tangential == TangentialLaw::linear ? p.k_t : 0.0,
                                    p.tangential == TangentialLaw::linear ? p.k_t : 0.0,

@@ -77,12 +77,6 @@ Vector spook_rhs(const ContactSystem &sys, const Vector *extra_dv)
           sys.inv_mass()[kBodyDofs * k.a] + (k.is_wall() ? 0.0 : sys.inv_mass()[kBodyDofs * k.b]);
       const double jump = (b[row] - (ups_c + k.restitution) * vn) * (1.0 + sys.sigma()[row] / w_nn);
       b[row] = std::max(b_spook, jump);
-      // The impact's rigid rows stick within the step where their cones allow (Newton's law
-      // with Coulomb friction, no tangential restitution): SPOOK's damping would leave Upsilon
-      // of the slip, and the contact opens before a later step removes it.
-      for (int r = 1; r < rows; ++r)
-        if (!k.elastic[r] && sys.row_active(row + r))
-          b[row + r] -= p.upsilon(p.damping_of(k, r)) * (Gv[row + r] - wall[r]);
     } else if (bounces && k.gap > 0) {
       // Free flight, but not through the contact within the step when other contacts stop
       // the partner: G_n v+ >= -gap / h.
