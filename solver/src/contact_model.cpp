@@ -47,9 +47,10 @@ void apply_pair(const ContactModel &model, const PairCoefficients &pc, double h,
   // The rolling and twisting springs carry the law's own damper, not the contact's critical
   // damping: SPOOK's damping time is the Kelvin-Voigt element's gamma / k. SPOOK's d is the
   // floor (below two steps a spring stiffer than the step rings; doc/design.md section 2).
+  const double floor = std::max(model.damping, c.damping);
   for (int r = 3; r < rows; ++r) {
     const double tau = spring_damping_time(pc, r);
-    if (c.elastic[r] && tau > 0) c.spring_damping[r] = std::max(model.damping, tau / h);
+    if (c.elastic[r] && tau > 0) c.spring_damping[r] = std::max(floor, tau / h);
   }
 }
 
