@@ -316,8 +316,8 @@ TEST(Material, HertzMaterialStiffnessMixesLikeEAndNu)
 }
 
 // compliance material on a new contact and a loaded one: the SDS rolling rows are elastic from
-// the first step and carry the damping time gamma / k in steps (SPOOK's d as a floor); the
-// normal row takes the contact's damping.
+// the first step and carry the damping time gamma / k in steps, at least the contact's own
+// (SPOOK's d, or the critical damping of a soft loaded contact).
 TEST(Material, RollingSpringsCarryTheirDamperFromTheFirstStep)
 {
   std::vector<Body> bodies(2);
@@ -343,9 +343,12 @@ TEST(Material, RollingSpringsCarryTheirDamperFromTheFirstStep)
   last[6] = 1e-3;
   for (const double h : {1e-3, 1e-4}) {
     apply_contact_model(model, h, 1.0, bodies, contacts, &last);
+    EXPECT_LT(contacts[0].damping, 0.0);      // unloaded: SPOOK's d
+    EXPECT_GT(contacts[1].damping, 1e-2 / h); // loaded and soft: its critical damping is longer
     for (const Contact &c : contacts) {
       EXPECT_TRUE(c.elastic[4] && c.elastic[5]);
-      EXPECT_DOUBLE_EQ(c.spring_damping[4], std::max(model.damping, 1e-2 / h));
+      const double floor = std::max(model.damping, c.damping);
+      EXPECT_DOUBLE_EQ(c.spring_damping[4], std::max(floor, 1e-2 / h));
       EXPECT_EQ(c.spring_damping[5], c.spring_damping[4]);
       for (int r : {0, 1, 2, 3}) EXPECT_EQ(c.spring_damping[r], -1.0) << r;
     }
