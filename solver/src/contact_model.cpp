@@ -44,9 +44,10 @@ void apply_pair(const ContactModel &model, const PairCoefficients &pc, double h,
   const double m_eff = c.is_wall() ? ma : ma * bodies[c.b].mass / (ma + bodies[c.b].mass);
   const double critical = 2.0 * std::sqrt(m_eff * c.compliance[0]) / h;
   if (critical > model.damping) c.damping = critical;
-  // The rolling and twisting springs carry the law's own damper, not the contact's critical
-  // damping: SPOOK's damping time is the Kelvin-Voigt element's gamma / k. SPOOK's d is the
-  // floor (below two steps a spring stiffer than the step rings; doc/design.md section 2).
+  // The SDS rolling and twisting springs carry the law's own damper (SPOOK's damping time is
+  // the Kelvin-Voigt element's gamma / k), at least the contact's: two steps, below which a
+  // spring stiffer than the step rings, or a soft loaded contact's critical damping, without
+  // which a pile at rest rocks on its rolling springs (doc/design.md, session 15).
   const double floor = std::max(model.damping, c.damping);
   for (int r = 3; r < rows; ++r) {
     const double tau = spring_damping_time(pc, r);
