@@ -203,7 +203,7 @@ void LammpsDetection::pair_contacts(const std::vector<fibre::Body> &bodies, doub
 void LammpsDetection::add_wall_contact(const std::vector<fibre::Body> &bodies, int body,
                                        const fibre::Vec3 &n, double distance, int wall, int sub,
                                        const fibre::Vec3 &wall_v, const fibre::Vec3 &wall_omega,
-                                       double h, double damping,
+                                       double wall_radius, double h, double damping,
                                        std::vector<fibre::DetectedContact> &found) const
 {
   if (!accept(bodies[body], nullptr, n, distance - bodies[body].radius, h, damping, kick(body),
@@ -213,6 +213,7 @@ void LammpsDetection::add_wall_contact(const std::vector<fibre::Body> &bodies, i
   fc.contact = fibre::sphere_wall_contact(bodies, body, n, distance);
   fc.contact.wall_v = wall_v;
   fc.contact.wall_omega = wall_omega;
+  fc.contact.wall_radius = wall_radius;
   fc.store = exchange_.body_atom()[body];
   fc.tag_a = atom->tag[fc.store];
   fc.partner = fibre::wall_key(wall, sub);
@@ -234,7 +235,8 @@ void LammpsDetection::wall_contacts(const std::vector<fibre::Body> &bodies, doub
         const int n = fibre::plane_hits(walls_[w], bodies[k], skin, hits, wall_time_);
         for (int s = 0; s < n; ++s) {
           add_wall_contact(bodies, k, hits[s].normal, hits[s].distance, w, hits[s].sub,
-                           walls_[w].velocity(wall_time_), fibre::Vec3::Zero(), h, damping, found);
+                           walls_[w].velocity(wall_time_), fibre::Vec3::Zero(), 0.0, h, damping,
+                           found);
         }
       }
       continue;

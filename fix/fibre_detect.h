@@ -45,9 +45,10 @@ class LammpsDetection : protected LAMMPS_NS::Pointers {
   void wall_contacts(const std::vector<fibre::Body> &bodies, double h, double damping,
                      std::vector<fibre::DetectedContact> &found) const;
   // A wall contact of body with the wall's surface velocity at the point and angular velocity.
+  // wall_radius: the surface's radius of curvature (Contact::wall_radius), 0 for a plane.
   void add_wall_contact(const std::vector<fibre::Body> &bodies, int body, const fibre::Vec3 &n,
                         double distance, int wall, int sub, const fibre::Vec3 &wall_v,
-                        const fibre::Vec3 &wall_omega, double h, double damping,
+                        const fibre::Vec3 &wall_omega, double wall_radius, double h, double damping,
                         std::vector<fibre::DetectedContact> &found) const;
 
   double kick(int body) const { return kick_.empty() ? 0.0 : kick_[body]; }

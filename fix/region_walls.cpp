@@ -178,8 +178,9 @@ void LammpsDetection::host_wall_contacts(int w, const std::vector<fibre::Body> &
         const double p[3] = {b.x[0] - rc.delx, b.x[1] - rc.dely, b.x[2] - rc.delz};
         surface_velocity(contact_owner(domain, region, rc.iwall), p, wall_v, wall_omega);
       }
+      // the region's curvature at the contact, as fix wall/gran/region passes it
       add_wall_contact(bodies, k, n, rc.r, w, std::min(rc.iwall, fibre::kWallKeyStride - 1), wall_v,
-                       wall_omega, h, damping, found);
+                       wall_omega, rc.radius, h, damping, found);
     }
   }
 }

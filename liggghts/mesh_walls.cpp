@@ -182,7 +182,7 @@ void LammpsDetection::host_wall_contacts(int w, const std::vector<fibre::Body> &
     for (const fibre::TriangleHit &hit : host.hits) {
       const std::size_t before = found.size();
       add_wall_contact(bodies, k, hit.normal, hit.distance, w, 0, hit.velocity, fibre::Vec3::Zero(),
-                       h, damping, found);
+                       0.0, h, damping, found);
       if (found.size() == before) continue;
       fibre::DetectedContact &fc = found.back();
       fc.partner = fc.key = fibre::mesh_key(w, mesh.triangles[hit.triangle].id);

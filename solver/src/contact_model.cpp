@@ -7,7 +7,9 @@ namespace fibre {
 double effective_radius(const std::vector<Body> &bodies, const Contact &c)
 {
   const double ra = bodies[c.a].radius;
-  if (c.is_wall()) return c.wall_radius > 0 ? effective_radius(ra, &c.wall_radius) : ra;
+  // a wall's curvature radius R: > 0 convex, < 0 concave (LAMMPS's region contacts), 0 flat
+  const double R = c.wall_radius;
+  if (c.is_wall()) return R > 0 || R < -ra ? effective_radius(ra, &R) : ra;
   return effective_radius(ra, &bodies[c.b].radius);
 }
 

@@ -409,8 +409,9 @@ ContactSystem parse_system(std::string_view text)
     }
     if (version <= 5) continue;
     k.wall_radius = in.real(t[kContactFieldsV5], what + " wall radius");
-    if (!(k.wall_radius >= 0) || (!k.is_wall() && k.wall_radius != 0))
-      in.fail(what + ": the wall radius must be >= 0, and 0 for a pair");
+    // version 7 also has concave walls (< 0)
+    if (!(k.wall_radius >= 0 || version >= 7) || (!k.is_wall() && k.wall_radius != 0))
+      in.fail(what + ": the wall radius must be >= 0 (any value from version 7), and 0 for a pair");
     if (version <= 6) continue;
     for (int r = 1; r < kMaxRows; ++r) {
       const double d = in.real(t[kContactFieldsV6 + r - 1], what + " spring damping");

@@ -359,3 +359,22 @@ TEST(Material, RollingSpringsCarryTheirDamperFromTheFirstStep)
   apply_contact_model(model, 1e-1, 1.0, bodies, contacts, &last);
   EXPECT_DOUBLE_EQ(contacts[0].spring_damping[4], model.damping);
 }
+
+// A wall's curvature: LAMMPS's region contacts give -R inside a sphere of radius R (-2 R inside
+// a cylinder), an obstacle sphere +R, a plane 0; the laws take r R / (r + R).
+TEST(Material, WallCurvatureGivesTheEffectiveRadius)
+{
+  std::vector<Body> bodies(1);
+  bodies[0].radius = 0.5;
+  Contact c;
+  c.a = 0; // a wall
+  EXPECT_DOUBLE_EQ(effective_radius(bodies, c), 0.5);
+  c.wall_radius = 1.5; // an obstacle sphere
+  EXPECT_DOUBLE_EQ(effective_radius(bodies, c), 0.375);
+  c.wall_radius = -1.0; // inside a spherical region of radius 1: twice the sphere's
+  EXPECT_DOUBLE_EQ(effective_radius(bodies, c), 1.0);
+  c.wall_radius = -8.0; // inside a cylinder of radius 4
+  EXPECT_DOUBLE_EQ(effective_radius(bodies, c), 0.5 * 8.0 / 7.5);
+  c.wall_radius = -0.4; // curved tighter than the sphere (cannot touch there): a plane's
+  EXPECT_DOUBLE_EQ(effective_radius(bodies, c), 0.5);
+}

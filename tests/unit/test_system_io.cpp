@@ -241,6 +241,12 @@ TEST(SystemIo, OlderVersionsAndCoefficientFields)
   EXPECT_EQ(v6.contacts()[2].spring_damping,
             (std::array<double, kMaxRows>{-1, -1, -1, -1, -1, -1}));
   EXPECT_EQ(v6.contacts()[2].wall_radius, sys.contacts()[2].wall_radius);
+  // a concave wall (a negative radius) is version 7's: version 6 rejects it
+  const std::string v6_text = older_version(sys, 6, 0, 5);
+  const std::size_t convex = v6_text.find(" 0.375\n");
+  ASSERT_NE(convex, std::string::npos);
+  expect_error(v6_text.substr(0, convex) + " -0.375\n" + v6_text.substr(convex + 7),
+               {"the wall radius must be >= 0"});
   // the first contact line with a negative twisting coefficient, a restitution of 2 and a
   // negative damping other than -1
   const std::string text = to_text(sys);
@@ -260,6 +266,10 @@ TEST(SystemIo, OlderVersionsAndCoefficientFields)
   expect_error(with(23, "-1"), {"contact 0:", "mu_twist must not be negative"});
   expect_error(with(24, "2"), {"contact 0:", "restitution must be in [0, 1]"});
   expect_error(with(25, "-2"), {"contact 0:", "damping must be non-negative"});
+  if (sys.contacts()[0].is_wall()) // inside a region of radius 2
+    EXPECT_EQ(parse_system(with(38, "-2")).contacts()[0].wall_radius, -2.0);
+  else
+    expect_error(with(38, "-2"), {"contact 0:", "0 for a pair"});
   EXPECT_EQ(parse_system(with(25, "-1")).contacts()[0].damping, -1.0);
   expect_error(with(32, "64"), {"contact 0:", "elastic rows must be a bit mask"});
   expect_error(with(33, "0.5"), {"contact 0:", "a spring on row 1, which is not elastic"});

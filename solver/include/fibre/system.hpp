@@ -65,9 +65,11 @@ struct Contact {
   // (zero for walls at rest). They enter the rhs as the velocity of body b (spook_rhs).
   Vec3 wall_v = Vec3::Zero();
   Vec3 wall_omega = Vec3::Zero();
-  // An obstacle sphere's radius (an atom outside the fix's group), 0 for a flat or region
-  // wall: the effective radius of the contact's Hertz, rolling and twisting laws is
-  // ra wall_radius / (ra + wall_radius), as the pair style's between the two atoms.
+  // A wall's radius of curvature at the contact: an obstacle sphere's radius (an atom outside
+  // the fix's group), a region's as LAMMPS gives it to fix wall/gran/region (negative where
+  // the surface is concave: -R inside a sphere, -2 R inside a cylinder), 0 for a flat wall.
+  // The effective radius of the contact's Hertz, rolling and twisting laws is
+  // ra wall_radius / (ra + wall_radius), as LAMMPS's.
   double wall_radius = 0.0;
   // Elastic rows (compliance material): a row whose compliance is the law's spring carries
   // its displacement at the step's start, in the contact frame, in the rhs as the normal row
