@@ -50,17 +50,18 @@ Vector spook_rhs(const ContactSystem &sys, const Vector *extra_dv)
     const Contact &k = sys.contacts()[c];
     const Eigen::Index row = Eigen::Index(rows) * c; // normal row
     const double ups_c = p.upsilon(p.damping_of(k));
+    double ups_r[kMaxRows]; // each row's Upsilon
+    for (int r = 0; r < rows; ++r) ups_r[r] = p.upsilon(p.damping_of(k, r));
     if (k.own_damping()) // -(1 - Upsilon_r) G v on every row of the contact
-      for (int r = 0; r < rows; ++r)
-        b[row + r] += (p.upsilon(p.damping_of(k, r)) - ups) * Gv[row + r];
+      for (int r = 0; r < rows; ++r) b[row + r] += (ups_r[r] - ups) * Gv[row + r];
     // A moving wall is body b with a prescribed velocity, the same after the step:
     // -(1 - Upsilon) G v of the relative velocity, G_b w_b = -wall_rows.
     const std::array<double, kMaxRows> wall = wall_rows(k);
     if (k.wall_moves())
-      for (int r = 0; r < rows; ++r) b[row + r] += (1.0 - p.upsilon(p.damping_of(k, r))) * wall[r];
+      for (int r = 0; r < rows; ++r) b[row + r] += (1.0 - ups_r[r]) * wall[r];
     for (int r = 1; r < rows; ++r)
       if (k.elastic[r] && sys.row_active(row + r))
-        b[row + r] += p.spring_term(k.spring[r], p.upsilon(p.damping_of(k, r)));
+        b[row + r] += p.spring_term(k.spring[r], ups_r[r]);
     if (!sys.row_active(row)) continue;
     const double b_spook = b[row] + p.gap_term(k.gap, ups_c, k.elastic[0]);
     // Row: G_n v+ + eps lambda_n = G_n (v + h M^-1 f) + b_n, so b_n = 0 is free flight and
