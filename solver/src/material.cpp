@@ -150,27 +150,15 @@ bool material_compliance(const PairCoefficients &p, double r_eff, double overlap
   const double d_now = std::max(overlap, 0.0);
   const double f_now = hertz ? p.k_n * std::sqrt(r_eff * d_now) * d_now : p.k_n * d_now;
   const double f = std::max(last_force, f_now);
-  const double k_roll = p.k_roll * r_eff * r_eff; // torque per unit angle
-  // unloaded: the load-free springs only
-  if (!(f > 0)) {
-    const double free[kMaxRows] = {0.0,
-                                   p.tangential == TangentialLaw::linear ? p.k_t : 0.0,
-                                   p.tangential == TangentialLaw::linear ? p.k_t : 0.0,
-                                   p.twist == TwistLaw::sds ? p.k_twist : 0.0,
-                                   k_roll,
-                                   k_roll};
-    for (int r = 1; r < kMaxRows; ++r)
-      if (free[r] > 0) {
-        eps[r] = 1.0 / free[r];
-        elastic[r] = true;
-      }
-    return true;
+  // the law's overlap at the reference load, and its contact radius; unloaded (f = 0), the
+  // normal row stays rigid and the springs that need a contact radius vanish with a = 0
+  double a = 0.0;
+  if (f > 0) {
+    const double d = hertz ? std::cbrt(f * f / (p.k_n * p.k_n * r_eff)) : f / p.k_n;
+    eps[0] = d / f;
+    elastic[0] = true; // the gap is the law's overlap at the load
+    a = std::sqrt(r_eff * d);
   }
-  // the law's overlap at the reference load, and its contact radius
-  const double d = hertz ? std::cbrt(f * f / (p.k_n * p.k_n * r_eff)) : f / p.k_n;
-  eps[0] = d / f;
-  elastic[0] = true; // the gap is the law's overlap at the load
-  const double a = std::sqrt(r_eff * d);
   // the springs, each with its displacement in the rhs (Contact::spring)
   const double k_t = p.tangential == TangentialLaw::mindlin  ? p.k_t * a
                      : p.tangential == TangentialLaw::linear ? p.k_t
@@ -178,6 +166,7 @@ bool material_compliance(const PairCoefficients &p, double r_eff, double overlap
   const double k_twist = p.twist == TwistLaw::marshall ? 0.5 * k_t * a * a
                          : p.twist == TwistLaw::sds    ? p.k_twist
                                                        : 0.0;
+  const double k_roll = p.k_roll * r_eff * r_eff; // torque per unit angle
   const double stiffness[kMaxRows] = {0.0, k_t, k_t, k_twist, k_roll, k_roll};
   for (int r = 1; r < kMaxRows; ++r)
     if (stiffness[r] > 0) {
