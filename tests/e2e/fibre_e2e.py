@@ -77,6 +77,18 @@ def sphere_box(box, types=1, boundary="f f f", processors=None):
     return lines + ["region box block %s units box" % box, "create_box %d box" % types]
 
 
+def stacked_column(diameters):
+    """Spheres of these diameters stacked on z = 0 along the z axis, each touching the next:
+    their centres' heights and the create_atoms and set lines (density 1) that make them."""
+    centres, lines, z = [], [], 0.0
+    for i, d in enumerate(diameters):
+        centres.append(z + d / 2)
+        lines.append("create_atoms 1 single 0 0 %.17g units box" % centres[-1])
+        lines.append("set atom %d diameter %.17g density 1.0" % (i + 1, d))
+        z += d
+    return centres, lines
+
+
 def run_lmp(args, deck, name, np=1, variables=None, timeout=600):
     """Writes `deck` to WORKDIR/in.NAME and runs it with np processes (mpirun if np > 1)."""
     deck_path = os.path.join(args.workdir, "in." + name)

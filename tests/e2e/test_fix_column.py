@@ -29,12 +29,7 @@ STEPS = 1000
 
 
 def deck(opts):
-    lines = e2e.sphere_box("-3 3 -3 3 0 10")
-    z = 0.0
-    for i, d in enumerate(DIAMETERS):
-        lines.append("create_atoms 1 single 0 0 %.17g units box" % (z + d / 2))
-        lines.append("set atom %d diameter %.17g density 1.0" % (i + 1, d))
-        z += d
+    lines = e2e.sphere_box("-3 3 -3 3 0 10") + e2e.stacked_column(DIAMETERS)[1]
     lines += [
         "pair_style gran/hooke 1.0 NULL 0.0 NULL 0.0 0",
         "pair_coeff * *",
@@ -62,10 +57,7 @@ def main():
     args = e2e.parse_args()
     ck = e2e.Checks("resting column: %d spheres on a floor, %d steps" % (len(DIAMETERS), STEPS))
     masses = [math.pi / 6 * d ** 3 for d in DIAMETERS]
-    z0, z = [], 0.0
-    for d in DIAMETERS:
-        z0.append(z + d / 2)
-        z += d
+    z0 = e2e.stacked_column(DIAMETERS)[0]
     # (tag, options, impulse tolerance, kinetic energy bound, drift bound)
     cases = [
         ("cr_body", "form body solver cr linear_tol 1e-6", 1e-3, 1e-10, 5e-7),

@@ -27,11 +27,7 @@ STEPS = 600
 
 def deck(np):
     lines = e2e.sphere_box("-3 3 -3 3 0 12", processors="1 1 2" if np == 2 else None)
-    z = 0.0
-    for i, d in enumerate(DIAMETERS):
-        lines.append("create_atoms 1 single 0 0 %.17g units box" % (z + d / 2))
-        lines.append("set atom %d diameter %.17g density 1.0" % (i + 1, d))
-        z += d
+    lines += e2e.stacked_column(DIAMETERS)[1]
     lines += [
         "pair_style gran/hooke 1.0 NULL 0.0 NULL 0.0 0",
         "pair_coeff * *",
