@@ -546,7 +546,7 @@ void FixFibreContact::final_integrate()
   for (const fibre::DetectedContact &fc : found) contacts.push_back(fc.contact);
   const fibre::Vector warm = history_.warm_start(found, model.rows, dtv_);
   history_.load_springs(found, contacts);
-  if (any) fibre::apply_contact_model(model, dtv_, m_min_, bodies, contacts, &warm);
+  if (any) fibre::apply_contact_model(model, params, m_min_, bodies, contacts, &warm);
   fibre::ContactSystem sys(std::move(bodies), std::move(contacts), model.rows, params,
                            exchange_->num_owned());
 

@@ -23,9 +23,31 @@ namespace {
 
 // Contact c's coefficients from its type pair's (pc), and with compliance material its rows'
 // compliances, springs and damping.
-void apply_pair(const ContactModel &model, const PairCoefficients &pc, double h, double reff,
-                const std::vector<Body> &bodies, const Vector *last, std::size_t k, Contact &c)
+// A contact that bounces within the step touches for the law's collision time t_c only, at a
+// large step and a stiff material a fraction phi = t_c / h of the step: its springs and
+// dampers act for t_c (stiffness phi^2 k and damping phi gamma give the collision's impulses
+// k t_c^2 and gamma t_c). Over the whole step they took 1 / phi times the rolling resistance of
+// every bounce (doc/design.md, session 16). d is the rows' damping (steps) so far.
+void shorten_to_collision(const PairCoefficients &pc, const SpookParams &params, double reff,
+                          double m_eff, double approach, double d, int rows, Contact &c)
 {
+  const bool bounces = c.restitution > 0 && approach > params.bounce_speed &&
+                       c.gap <= params.h * approach;
+  if (!bounces) return;
+  const double phi = collision_time(pc, reff, m_eff, approach) / params.h;
+  if (!(phi > 0 && phi < 1)) return;
+  for (int r = 1; r < rows; ++r)
+    if (c.elastic[r]) {
+      c.compliance[r] /= phi * phi;
+      c.spring_damping[r] = (c.spring_damping[r] >= 0 ? c.spring_damping[r] : d) / phi;
+    }
+}
+
+void apply_pair(const ContactModel &model, const PairCoefficients &pc, const SpookParams &params,
+                double reff, const std::vector<Body> &bodies, const Vector *last, std::size_t k,
+                Contact &c)
+{
+  const double h = params.h;
   const double overlap = std::max(-c.gap, 0.0);
   const FrictionParams f = contact_friction(pc, reff, overlap);
   const TypedCoefficients &typed = model.typed;
@@ -55,14 +77,20 @@ void apply_pair(const ContactModel &model, const PairCoefficients &pc, double h,
     const double tau = spring_damping_time(pc, r);
     if (c.elastic[r] && tau > 0) c.spring_damping[r] = std::max(floor, tau / h);
   }
+  if (force == 0) { // an impact, unless it approaches too slowly
+    const Vec3 vb = c.is_wall() ? c.wall_v : bodies[c.b].v;
+    const double approach = -(bodies[c.a].v - vb).dot(c.normal);
+    shorten_to_collision(pc, params, reff, m_eff, approach, floor, rows, c);
+  }
 }
 
 } // namespace
 
-void apply_contact_model(const ContactModel &model, double h, double m_min,
+void apply_contact_model(const ContactModel &model, const SpookParams &params, double m_min,
                          const std::vector<Body> &bodies, std::vector<Contact> &contacts,
                          const Vector *last)
 {
+  const double h = params.h;
   const ComplianceParams &p = model.compliance;
   double eps_n = p.eps_n, eps_t = p.eps_t;
   if (p.automatic || p.material) eps_n = eps_t = p.factor * h * h / m_min;
@@ -80,7 +108,7 @@ void apply_contact_model(const ContactModel &model, double h, double m_min,
     const int tb = !c.is_wall() ? bodies[c.b].type : c.wall_type > 0 ? c.wall_type : ta;
     const int ntypes = model.materials.ntypes();
     if (model.per_type() && ta >= 1 && tb >= 1 && ta <= ntypes && tb <= ntypes)
-      apply_pair(model, model.materials.at(ta, tb), h, reff, bodies, last, k, c);
+      apply_pair(model, model.materials.at(ta, tb), params, reff, bodies, last, k, c);
     // An impact is a contact that carried no load in the last step; an enduring one does not
     // bounce (without external forces bounce_speed is 0, and Newton's law on every contact of
     // a sheared pack threw its grains out of the cell).

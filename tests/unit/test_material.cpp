@@ -11,6 +11,17 @@
 
 using namespace fibre;
 
+namespace {
+
+SpookParams step_of(double h)
+{
+  SpookParams params;
+  params.h = h;
+  return params;
+}
+
+} // namespace
+
 TEST(Material, TsujiFitAndInverse)
 {
   // pair_coeff ... hertz/material E e nu ... damping tsuji stores these (LAMMPS 29 Sep 2021)
@@ -149,7 +160,7 @@ TEST(Material, ApplyContactModelPerType)
   model.materials.at(1, 1) = a;
   model.materials.at(2, 2) = b;
   ASSERT_EQ(model.materials.mix(), "");
-  apply_contact_model(model, 1e-3, 1.0, bodies, contacts);
+  apply_contact_model(model, step_of(1e-3), 1.0, bodies, contacts);
   EXPECT_DOUBLE_EQ(contacts[0].friction.mu, 0.2);
   EXPECT_DOUBLE_EQ(contacts[1].friction.mu, 0.4);
   EXPECT_DOUBLE_EQ(contacts[2].friction.mu, 0.8);
@@ -164,7 +175,7 @@ TEST(Material, ApplyContactModelPerType)
   last[0] = 1e-3; // contact 0's normal impulse
   model.restitution = 0.5;
   model.typed.restitution = true;
-  apply_contact_model(model, 1e-3, 1.0, bodies, contacts, &last);
+  apply_contact_model(model, step_of(1e-3), 1.0, bodies, contacts, &last);
   EXPECT_DOUBLE_EQ(contacts[0].restitution, 0.0);
   EXPECT_DOUBLE_EQ(contacts[2].restitution, 0.5);
   model.typed = TypedCoefficients{};
@@ -172,12 +183,12 @@ TEST(Material, ApplyContactModelPerType)
   // typed keywords override every pair; coefficients fix ignores the table
   model.typed.mu = true;
   model.friction.mu = 0.9;
-  apply_contact_model(model, 1e-3, 1.0, bodies, contacts);
+  apply_contact_model(model, step_of(1e-3), 1.0, bodies, contacts);
   for (const Contact &c : contacts) EXPECT_DOUBLE_EQ(c.friction.mu, 0.9);
   model.typed = TypedCoefficients{};
   model.coefficients = CoefficientSource::fix;
   model.friction.mu = 0.5;
-  apply_contact_model(model, 1e-3, 1.0, bodies, contacts);
+  apply_contact_model(model, step_of(1e-3), 1.0, bodies, contacts);
   for (const Contact &c : contacts) EXPECT_DOUBLE_EQ(c.friction.mu, 0.5);
 }
 
@@ -342,7 +353,7 @@ TEST(Material, RollingSpringsCarryTheirDamperFromTheFirstStep)
   Vector last = Vector::Zero(12);
   last[6] = 1e-3;
   for (const double h : {1e-3, 1e-4}) {
-    apply_contact_model(model, h, 1.0, bodies, contacts, &last);
+    apply_contact_model(model, step_of(h), 1.0, bodies, contacts, &last);
     EXPECT_LT(contacts[0].damping, 0.0);      // unloaded: SPOOK's d
     EXPECT_GT(contacts[1].damping, 1e-2 / h); // loaded and soft: its critical damping is longer
     for (const Contact &c : contacts) {
@@ -356,8 +367,98 @@ TEST(Material, RollingSpringsCarryTheirDamperFromTheFirstStep)
     EXPECT_TRUE(contacts[1].elastic[0] && contacts[1].elastic[1]);
   }
   // the floor: a damper faster than two steps is SPOOK's two steps
-  apply_contact_model(model, 1e-1, 1.0, bodies, contacts, &last);
+  apply_contact_model(model, step_of(1e-1), 1.0, bodies, contacts, &last);
   EXPECT_DOUBLE_EQ(contacts[0].spring_damping[4], model.damping);
+}
+
+// The collision time of the elastic laws against the collision integrated by RK4 (m d'' = -F(d)
+// from d = 0 at the approach speed until the overlap closes again).
+TEST(Material, CollisionTimeOfTheElasticLaws)
+{
+  PairCoefficients p = hertz_material_pair();
+  const double r_eff = 0.2, m_eff = 0.13;
+  for (const NormalLaw law : {NormalLaw::hertz_material, NormalLaw::hooke})
+    for (const double v : {0.05, 3.0}) {
+      p.normal = law;
+      const double K = law == NormalLaw::hooke ? p.k_n : p.k_n * std::sqrt(r_eff);
+      const double power = law == NormalLaw::hooke ? 1.0 : 1.5;
+      const auto accel = [&](double d) { return -K * std::pow(std::max(d, 0.0), power) / m_eff; };
+      const double t_c = collision_time(p, r_eff, m_eff, v);
+      const double dt = t_c / 2e5;
+      double d = 0.0, u = v, t = 0.0;
+      while (true) {
+        const double k1d = u, k1u = accel(d);
+        const double k2d = u + 0.5 * dt * k1u, k2u = accel(d + 0.5 * dt * k1d);
+        const double k3d = u + 0.5 * dt * k2u, k3u = accel(d + 0.5 * dt * k2d);
+        const double k4d = u + dt * k3u, k4u = accel(d + dt * k3d);
+        const double d_next = d + dt / 6.0 * (k1d + 2.0 * k2d + 2.0 * k3d + k4d);
+        u += dt / 6.0 * (k1u + 2.0 * k2u + 2.0 * k3u + k4u);
+        if (t > 0 && d_next <= 0.0) {
+          t += dt * d / (d - d_next);
+          break;
+        }
+        d = d_next;
+        t += dt;
+      }
+      EXPECT_NEAR(t_c, t, 1e-5 * t) << (law == NormalLaw::hooke ? "hooke " : "hertz ") << v;
+    }
+  p.normal = NormalLaw::none;
+  EXPECT_EQ(collision_time(p, r_eff, m_eff, 1.0), 0.0);
+}
+
+// A bouncing impact's springs and dampers act for the collision time t_c, not the step:
+// stiffness phi^2 k and damping phi gamma (phi = t_c / h). An enduring contact, a plastic one
+// and one that approaches below the bounce speed keep the whole step.
+TEST(Material, ImpactSpringsActForTheCollisionTime)
+{
+  std::vector<Body> bodies(2);
+  bodies[1].x = Vec3(1.0, 0, 0);
+  for (Body &b : bodies) b.type = 1;
+  std::vector<Contact> at_rest(1);
+  at_rest[0].a = 1; // a touches b from +x: the normal points from b to a
+  at_rest[0].b = 0;
+  at_rest[0].normal = Vec3::UnitX();
+  ContactModel model;
+  model.compliance.automatic = false;
+  model.compliance.material = true;
+  model.materials = MaterialTable(1);
+  PairCoefficients p = hertz_material_pair();
+  p.k_roll = 1e3;
+  p.gamma_roll = 10.0;
+  p.restitution = 0.5;
+  model.materials.at(1, 1) = p;
+  SpookParams params = step_of(1e-1);
+  params.bounce_speed = 0.5;
+  apply_contact_model(model, params, 1.0, bodies, at_rest);
+  const double v = 3.0;
+  bodies[1].v = Vec3(-v, 0, 0);
+  std::vector<Contact> impact = at_rest;
+  apply_contact_model(model, params, 1.0, bodies, impact);
+  const double phi = collision_time(p, 0.5, 0.5, v) / params.h;
+  ASSERT_GT(phi, 0.01);
+  ASSERT_LT(phi, 0.5);
+  for (int r : {4, 5}) {
+    EXPECT_NEAR(impact[0].compliance[r], at_rest[0].compliance[r] / (phi * phi),
+                1e-12 * impact[0].compliance[r]);
+    EXPECT_NEAR(impact[0].spring_damping[r], at_rest[0].spring_damping[r] / phi,
+                1e-12 * impact[0].spring_damping[r]);
+  }
+  EXPECT_EQ(impact[0].compliance[0], at_rest[0].compliance[0]); // Newton's law on the normal
+  // below the bounce speed, plastic, or loaded in the last step: the whole step
+  std::vector<Contact> slow = at_rest;
+  bodies[1].v = Vec3(-0.4, 0, 0);
+  apply_contact_model(model, params, 1.0, bodies, slow);
+  EXPECT_EQ(slow[0].compliance[4], at_rest[0].compliance[4]);
+  bodies[1].v = Vec3(-v, 0, 0);
+  model.materials.at(1, 1).restitution = 0.0;
+  std::vector<Contact> plastic = at_rest;
+  apply_contact_model(model, params, 1.0, bodies, plastic);
+  EXPECT_EQ(plastic[0].compliance[4], at_rest[0].compliance[4]);
+  model.materials.at(1, 1).restitution = 0.5;
+  const Vector last = Vector::Constant(6, 1e-3);
+  std::vector<Contact> enduring = at_rest;
+  apply_contact_model(model, params, 1.0, bodies, enduring, &last);
+  EXPECT_EQ(enduring[0].compliance[4], at_rest[0].compliance[4]);
 }
 
 // A wall's curvature: LAMMPS's region contacts give -R inside a sphere of radius R (-2 R inside

@@ -86,8 +86,9 @@ double cone_coefficient(const FrictionParams &f, double r_eff, int cone);
 // sphere's type with itself, and typed keywords override them.
 // `last` (optional, rows per contact) holds each contact's impulses of the last step, for
 // compliance material's reference load; a contact that carried a normal impulse then is an
-// enduring contact, not an impact, and gets no restitution.
-void apply_contact_model(const ContactModel &model, double h, double m_min,
+// enduring contact, not an impact, and gets no restitution. `params` gives the step h and the
+// bounce speed: an impact that bounces has its springs for its collision time only.
+void apply_contact_model(const ContactModel &model, const SpookParams &params, double m_min,
                          const std::vector<Body> &bodies, std::vector<Contact> &contacts,
                          const Vector *last = nullptr);
 

@@ -108,6 +108,12 @@ bool material_compliance(const PairCoefficients &p, double r_eff, double overlap
                          const std::array<double, kMaxRows> &rigid,
                          std::array<double, kMaxRows> &eps, std::array<bool, kMaxRows> &elastic);
 
+// How long the pair's elastic normal law holds two bodies of reduced mass m_eff together when
+// they meet at approach speed v: pi sqrt(m_eff / k_n) for Hooke's law, and for Hertz's
+// (F = K d^3/2, K = k_n sqrt(r_eff)) 2.94 d_max / v with the deepest overlap
+// d_max = (5 m_eff v^2 / (4 K))^2/5. 0 where p has no normal law.
+double collision_time(const PairCoefficients &p, double r_eff, double m_eff, double v);
+
 // The damping time (seconds) of row r's spring in the pair's law, gamma / k of the SDS rolling
 // (rows 4, 5) and twisting (row 3) laws; 0 where the law has no damper of its own.
 double spring_damping_time(const PairCoefficients &p, int r);
