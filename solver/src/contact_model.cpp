@@ -75,7 +75,10 @@ void apply_pair(const ContactModel &model, const PairCoefficients &pc, const Spo
   const double floor = std::max(model.damping, c.damping);
   for (int r = 3; r < rows; ++r) {
     const double tau = spring_damping_time(pc, r);
-    if (c.elastic[r] && tau > 0) c.spring_damping[r] = std::max(floor, tau / h);
+    if (c.elastic[r] && tau > 0) {
+      c.spring_damping[r] = std::max(floor, tau / h);
+      c.damper_time[r] = tau;
+    }
   }
   if (force == 0) { // an impact, unless it approaches too slowly
     const Vec3 vb = c.is_wall() ? c.wall_v : bodies[c.b].v;
@@ -104,6 +107,7 @@ void apply_contact_model(const ContactModel &model, const SpookParams &params, d
     c.restitution = model.restitution;
     c.elastic.fill(false);
     c.spring_damping.fill(-1.0);
+    c.damper_time.fill(0.0);
     const int ta = bodies[c.a].type;
     const int tb = !c.is_wall() ? bodies[c.b].type : c.wall_type > 0 ? c.wall_type : ta;
     const int ntypes = model.materials.ntypes();

@@ -155,6 +155,17 @@ advance_springs(const ContactSystem &sys, const Vector &v_plus, const Vector &la
       if (xi.norm() > limit) {
         const double ln = l.norm();
         xi = ln > 0 ? Eigen::Vector2d(-limit / ln * l) : Eigen::Vector2d(limit / xi.norm() * xi);
+        // A spring with a damper of its own (SDS rolling, twisting) keeps, as LAMMPS's, the
+        // cone's force less the damper's (tau v): the two together are the cone's. Where the
+        // damper alone exceeds the cone, the spring then pushes along the motion. tau is the
+        // law's gamma / k, not SPOOK's floored damping, which is no force of the law.
+        const double tau = k.damper_time[rows_of.first];
+        if (ln > 0 && tau > 0) {
+          for (int i = 0; i < rows_of.size; ++i) {
+            const int r = rows_of.first + i;
+            xi[i] -= tau * (Gv[base + r] - wall[r]);
+          }
+        }
       }
       for (int i = 0; i < rows_of.size; ++i) springs[c][rows_of.first + i] = xi[i];
     }

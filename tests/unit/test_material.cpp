@@ -362,6 +362,10 @@ TEST(Material, RollingSpringsCarryTheirDamperFromTheFirstStep)
       EXPECT_DOUBLE_EQ(c.spring_damping[4], std::max(floor, 1e-2 / h));
       EXPECT_EQ(c.spring_damping[5], c.spring_damping[4]);
       for (int r : {0, 1, 2, 3}) EXPECT_EQ(c.spring_damping[r], -1.0) << r;
+      // the law's own damper, gamma / k, whatever SPOOK's floor
+      EXPECT_DOUBLE_EQ(c.damper_time[4], 1e-2);
+      EXPECT_EQ(c.damper_time[5], c.damper_time[4]);
+      for (int r : {0, 1, 2, 3}) EXPECT_EQ(c.damper_time[r], 0.0) << r;
     }
     EXPECT_FALSE(contacts[0].elastic[0] || contacts[0].elastic[1]); // no load: no Hertz, Mindlin
     EXPECT_TRUE(contacts[1].elastic[0] && contacts[1].elastic[1]);

@@ -244,6 +244,52 @@ TEST(ContactSolver, ElasticTangentialRowIsASpringUpToTheCone)
   EXPECT_NEAR(bodies[0].v.x(), 0.3 * kG * (200 - 1) * kH, 0.02 * 0.3 * kG * 200 * kH);
 }
 
+// At the rolling cone a spring with a damper of its own (SDS) keeps the cone's force less the
+// damper's, as LAMMPS's SDS law rescales its history: xi = -eps lambda / h - tau G v+. A sphere
+// rolls along the floor at 20 rad/s, where the damper's torque (tau k_roll omega, 32 N m) is
+// 50 times the cone's: the spring then pushes along the motion. Without a damper of its own
+// the spring keeps the cone's force alone, against the motion.
+TEST(ContactSolver, RollingSpringAtTheConeKeepsTheConeLessItsDamper)
+{
+  const double m = 1.5, r = 0.4, mu_roll = 0.1, omega = 20.0;
+  std::vector<Body> bodies{sphere(m, r, Vec3(0, 0, r))};
+  bodies[0].omega = Vec3(0, omega, 0);
+  bodies[0].v = Vec3(omega * r, 0, 0); // rolling: the contact point at rest
+  Contact contact = sphere_wall_contact(bodies, 0, Vec3::UnitZ(), r);
+  contact.compliance.fill(1e-14);
+  const double k_roll = 1e3 * r * r, tau = 10.0 / 1e3; // rolling sds 1e3 10
+  contact.compliance[4] = contact.compliance[5] = 1.0 / k_roll;
+  contact.elastic[4] = contact.elastic[5] = true;
+  contact.friction = FrictionParams{10.0, mu_roll, 0.0}; // no sliding
+  StepOptions o = base_options();
+  o.stop.tol = 1e-10;
+  for (const bool own : {true, false}) {
+    contact.spring_damping.fill(-1.0);
+    contact.damper_time.fill(0.0);
+    if (own) {
+      contact.spring_damping[4] = contact.spring_damping[5] = tau / kH;
+      contact.damper_time[4] = contact.damper_time[5] = tau;
+    }
+    ContactSystem sys(bodies, {contact}, 6, spook());
+    const StepResult res = solve(sys, o);
+    ASSERT_TRUE(res.converged);
+    const Vector v_plus = velocities_after(sys, serial_exchange(), res.lambda);
+    const std::array<double, kMaxRows> xi = advance_springs(sys, v_plus, res.lambda)[0];
+    Vector Gv;
+    g_apply(sys, v_plus, Gv);
+    const double l_roll = std::hypot(res.lambda[4], res.lambda[5]);
+    EXPECT_NEAR(l_roll, mu_roll * r * res.lambda[0], 1e-6 * l_roll) << own; // at the cone
+    const double t = own ? tau : 0.0;
+    for (int row : {4, 5})
+      EXPECT_NEAR(xi[row], -res.lambda[row] / (k_roll * kH) - t * Gv[row], 1e-12) << own;
+    const double along = -(xi[4] * Gv[4] + xi[5] * Gv[5]); // the spring's push along the motion
+    if (own)
+      EXPECT_GT(along, 0.0);
+    else
+      EXPECT_LT(along, 0.0);
+  }
+}
+
 // max_recovery bounds the removal of a rigid row's overlap, not the force of a material one.
 // A sphere pressed 4x deeper into the floor than Hertz's overlap under its weight, with the
 // material's secant compliance (compliance material) and a recovery speed that would cap the

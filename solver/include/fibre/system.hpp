@@ -83,6 +83,10 @@ struct Contact {
   // rolling and twisting dampers (a spring and a damper are SPOOK's compliance and damping
   // time). Rows 1..5; row 0 takes the contact's.
   std::array<double, kMaxRows> spring_damping{-1.0, -1.0, -1.0, -1.0, -1.0, -1.0};
+  // The law's own damper of an elastic row, its time gamma / k (seconds; 0: none): a spring at
+  // its cone keeps the cone's force less the damper's (advance_springs). Not in the system
+  // file: the solve does not read it.
+  std::array<double, kMaxRows> damper_time{};
   // Whether some row is damped otherwise than the system's SpookParams::damping.
   bool own_damping() const
   {
