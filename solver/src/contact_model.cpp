@@ -31,8 +31,8 @@ namespace {
 void shorten_to_collision(const PairCoefficients &pc, const SpookParams &params, double reff,
                           double m_eff, double approach, double d, int rows, Contact &c)
 {
-  const bool bounces = c.restitution > 0 && approach > params.bounce_speed &&
-                       c.gap <= params.h * approach;
+  const bool bounces =
+      c.restitution > 0 && approach > params.bounce_speed && c.gap <= params.h * approach;
   if (!bounces) return;
   const double phi = collision_time(pc, reff, m_eff, approach) / params.h;
   if (!(phi > 0 && phi < 1)) return;

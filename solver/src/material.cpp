@@ -182,8 +182,7 @@ double collision_time(const PairCoefficients &p, double r_eff, double m_eff, dou
   if (p.normal == NormalLaw::hooke) return std::acos(-1.0) * std::sqrt(m_eff / p.k_n);
   if (!(r_eff > 0) || !(v > 0)) return 0.0;
   // t = 2 (d_max / v) int_0^1 dx / sqrt(1 - x^5/2), the integral 0.4 B(0.4, 0.5)
-  static const double half_period =
-      0.4 * std::tgamma(0.4) * std::tgamma(0.5) / std::tgamma(0.9);
+  static const double half_period = 0.4 * std::tgamma(0.4) * std::tgamma(0.5) / std::tgamma(0.9);
   const double K = p.k_n * std::sqrt(r_eff);
   const double d_max = std::pow(1.25 * m_eff * v * v / K, 0.4);
   return 2.0 * half_period * d_max / v;
