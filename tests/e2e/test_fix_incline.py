@@ -12,7 +12,9 @@ The acceleration is measured from the velocity along the slope between t = 2 and
 - twisting resistance: a sphere spinning about the normal stops at the rate
   mu_t r N / I = mu_t g / (0.4 r), and stays stopped;
 - a sphere launched at v0 along a flat floor slides, spins up and rolls on at 5/7 v0; with
-  rolling locked it slides to a stop at x = v0^2 / (2 mu g) without spinning.
+  rolling locked it slides to a stop at x = v0^2 / (2 mu g) without spinning;
+- a sphere rolling at v0 on the decks' material (pair granular, rolling sds 1e3 10 0.3, whose
+  damper outlasts the step) stops at x = v0^2 / (2 a), a = 5/7 mu_r g, as LAMMPS's own run does.
 Accelerations must agree within 2%; a sticking sphere must not move by more than 1e-3
 diameters (SPOOK's velocity-level friction allows a creep of eps_t F_t / (d dt) per unit time,
 a few 1e-6 here).
@@ -53,6 +55,30 @@ def deck(theta_deg, opts, omega_z=0.0, vx=0.0):
         "thermo_modify format float %.15g",
         "thermo 100",
         "run %d" % T2_STEP,
+    ]) + "\n"
+
+
+def sds_deck(v0, dt):
+    """A sphere of diameter 0.8 rolling at v0 along the floor, the material decks' pair_coeff."""
+    law = ("hertz/material 1e8 0.1 0.2857142857 tangential mindlin NULL 1.0 0.5 "
+           "rolling sds 1e3 10 0.3 damping tsuji")
+    return "\n".join(e2e.sphere_box("-5 20 -3 3 -1 5") + [
+        "create_atoms 1 single 0 0 0.4 units box",
+        "set atom 1 diameter 0.8 density 1.0",
+        "velocity all set %.17g 0 0 units box" % v0,
+        "set atom 1 omega 0 %.17g 0" % (v0 / 0.4),
+        "pair_style granular",
+        "pair_coeff * * " + law,
+        "neighbor 0.2 bin",
+        "timestep %g" % dt,
+        "fix g all gravity 9.81 vector 0 0 -1",
+        "fix fc all fibre_contact wall zplane 0.0 NULL",
+        "compute p all property/atom xu vx",
+        "compute s all reduce sum c_p[1] c_p[2]",
+        "thermo_style custom step c_s[1] c_s[2]",
+        "thermo_modify format float %.15g",
+        "thermo 100",
+        "run %d" % round(2.0 / dt),
     ]) + "\n"
 
 
@@ -137,6 +163,17 @@ def main():
                      "%s: rolls on at 5/7 v0 without slipping" % tag,
                      "v = %.6g (5/7 v0 = %.6g), omega_y r = %.6g" % (v_end, 5 / 7 * v0,
                                                                     w_end * r))
+
+    # SDS rolling resistance at the decks' step (4.4 ms; the spring's damper lasts 10 ms): a
+    # sphere rolling at 3 m/s stops at v0^2 / (2 a), a = 5/7 mu_r g (2.14 m)
+    v0, mu_r = 3.0, 0.3
+    run = e2e.run_lmp(args, sds_deck(v0, 4.4e-3), "incline_sds_roll")
+    if ck.ran(run, "sds_roll: run completes"):
+        last = run.thermo[-1][-1]
+        x_stop = v0 * v0 / (2.0 * 5.0 / 7.0 * mu_r * 9.81)
+        ck.check(abs(last["c_s[2]"]) < 1e-3 and e2e.rel_err(last["c_s[1]"], x_stop) < 0.02,
+                 "sds_roll: stops at v0^2 / (2 * 5/7 mu_r g)",
+                 "x = %.4g, expected %.4g, v = %.3g" % (last["c_s[1]"], x_stop, last["c_s[2]"]))
 
     # twisting resistance: spin about the normal decays at mu_t g / (0.4 r)
     mu_t, w0 = 0.2, 2.0
