@@ -199,6 +199,20 @@ TEST(ContactSolver, PulledSphereSticksOrSlides)
   }
 }
 
+// One step of a single sphere on its one contact: solve, carry the contact's springs, update
+// the sphere's velocities (not its position). Returns whether the solve converged.
+bool step_sphere(std::vector<Body> &bodies, Contact &contact, const SpookParams &params,
+                 const StepOptions &o)
+{
+  ContactSystem sys(bodies, {contact}, 6, params);
+  const StepResult res = solve(sys, o);
+  contact.spring =
+      advance_springs(sys, velocities_after(sys, serial_exchange(), res.lambda), res.lambda)[0];
+  bodies[0].v += params.h * bodies[0].force / bodies[0].mass + res.dv.head<3>();
+  bodies[0].omega += res.dv.segment<3>(3);
+  return res.converged;
+}
+
 // An elastic tangential row (compliance material's Mindlin or linear spring) with its
 // displacement carried from step to step: a sphere pulled below the friction limit settles
 // where the spring carries the pull (xi = F eps_t), springs back to where it started when the
@@ -220,13 +234,7 @@ TEST(ContactSolver, ElasticTangentialRowIsASpringUpToTheCone)
   const auto run = [&](double pull, int n) {
     for (int s = 0; s < n; ++s) {
       bodies[0].force.x() = pull * m * kG;
-      ContactSystem sys(bodies, {contact}, 6, spook());
-      const StepResult res = solve(sys, o);
-      ASSERT_TRUE(res.converged);
-      contact.spring =
-          advance_springs(sys, velocities_after(sys, serial_exchange(), res.lambda), res.lambda)[0];
-      bodies[0].v += kH * bodies[0].force / m + res.dv.head<3>();
-      bodies[0].omega += res.dv.segment<3>(3);
+      ASSERT_TRUE(step_sphere(bodies, contact, spook(), o));
       x += kH * bodies[0].v.x();
     }
   };
@@ -322,15 +330,7 @@ TEST(ContactSolver, RollingSphereSlowsAtTheConesRate)
   StepOptions o = base_options();
   o.stop.tol = 1e-10;
   const int steps = 100;
-  for (int s = 0; s < steps; ++s) {
-    ContactSystem sys(bodies, {contact}, 6, params);
-    const StepResult res = solve(sys, o);
-    ASSERT_TRUE(res.converged);
-    contact.spring =
-        advance_springs(sys, velocities_after(sys, serial_exchange(), res.lambda), res.lambda)[0];
-    bodies[0].v += h * bodies[0].force / m + res.dv.head<3>();
-    bodies[0].omega += res.dv.segment<3>(3);
-  }
+  for (int s = 0; s < steps; ++s) ASSERT_TRUE(step_sphere(bodies, contact, params, o));
   const double slowed = omega * r - bodies[0].v.x();
   const double analytic = 5.0 / 7.0 * mu_roll * kG * steps * h;
   EXPECT_NEAR(slowed, analytic, 0.01 * analytic);
