@@ -130,9 +130,8 @@ advance_springs(const ContactSystem &sys, const Vector &v_plus, const Vector &la
 {
   const int rows = sys.rows(), nc = sys.num_contacts();
   std::vector<std::array<double, kMaxRows>> springs(nc);
-  Vector Gv, Gv0;
+  Vector Gv, Gv0; // Gv0: G v at the step's start, for the springs with a damper of their own
   g_apply(sys, v_plus, Gv);
-  g_apply(sys, body_velocities(sys), Gv0);
   const Cones cones(sys);
   const double h = sys.params().h;
   for (int c = 0; c < nc; ++c) {
@@ -165,6 +164,7 @@ advance_springs(const ContactSystem &sys, const Vector &v_plus, const Vector &la
         // torque (by 13% at the decks' step).
         const double tau = k.damper_time[rows_of.first];
         if (ln > 0 && tau > 0) {
+          if (Gv0.size() == 0) g_apply(sys, body_velocities(sys), Gv0);
           Eigen::Vector2d w = Eigen::Vector2d::Zero(), w0 = Eigen::Vector2d::Zero();
           for (int i = 0; i < rows_of.size; ++i) {
             const int r = rows_of.first + i;

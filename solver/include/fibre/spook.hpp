@@ -47,8 +47,9 @@ ContactWork contact_work(const ContactSystem &sys, const Vector &v_plus, const V
 // keeps only the displacement whose force the cone carries, -eps lambda / h (LAMMPS's history
 // rescaling), so that a sliding contact snaps back by its elastic part only; a spring with a
 // damper of its own (Contact::damper_time tau = gamma / k: SDS rolling and twisting) keeps that
-// less the damper's share, -eps lambda / h - tau G v+, as LAMMPS's SDS laws do. Zero on rows that
-// are not elastic. v_plus: velocities_after(sys, ex, lambda).
+// less the damper's share, tau G v+, as LAMMPS's SDS laws do, less what SPOOK's row already
+// takes from its slowing. Zero on rows that are not elastic. v_plus: velocities_after(sys, ex,
+// lambda).
 std::vector<std::array<double, kMaxRows>>
 advance_springs(const ContactSystem &sys, const Vector &v_plus, const Vector &lambda);
 
