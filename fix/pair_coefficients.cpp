@@ -112,6 +112,14 @@ void read_granular(const std::string &bytes, int ntypes, PairReading &out)
                                                                  : fibre::NormalLaw::hertz,
                                                    normal[1], p.limit_damping);
       }
+      // the viscous models' dashpots (velocity, mass_velocity, viscoelastic: 0, 1, 2)
+      if (model[1] != kTsuji) {
+        const fibre::ViscousDamping viscous[3] = {fibre::ViscousDamping::velocity,
+                                                  fibre::ViscousDamping::mass_velocity,
+                                                  fibre::ViscousDamping::viscoelastic};
+        p.viscous = viscous[model[1]];
+        p.viscous_coeff = normal[1];
+      }
       cohesion = cohesion || model[0] == kDmt || model[0] == kJkr;
       if (model[1] != kTsuji)
         out.notes.push_back("types " + std::to_string(i) + " " + std::to_string(j) + ": damping " +
@@ -130,9 +138,10 @@ void read_granular(const std::string &bytes, int ntypes, PairReading &out)
   }
   out.notes.push_back("the stiffnesses of pair_coeff (normal, tangential, rolling and twisting "
                       "sds) set the rows' compliance ('compliance material', the default here; "
-                      "'compliance auto' makes the rows rigid), and the rolling and twisting sds "
-                      "dampers their springs' damping; the normal and tangential damping "
-                      "coefficients are not used (SPOOK's damping, and e for bounces)");
+                      "'compliance auto' makes the rows rigid), and the normal, rolling and "
+                      "twisting dampers their rows' damping, at least SPOOK's (the tangential "
+                      "rows take the normal one's; bounces take e); the tangential damping "
+                      "coefficient is not used");
   if (cohesion) out.notes.push_back("the cohesion of dmt and jkr is not modelled");
   out.table = std::move(table);
   out.material = true;

@@ -7,7 +7,8 @@
 //   coefficientRollingFriction peratomtypepair -> mu_roll, with rolling_friction cdt or epsd*
 //   youngsModulus, poissonsRatio peratomtype   -> model hertz: k_n = 4/3 Y*, k_t = 8 G*
 //     (1/Y* = (1 - nu_i^2)/Y_i + (1 - nu_j^2)/Y_j, 1/G* = 2 (2 - nu_i)(1 + nu_i)/Y_i + ...),
-//     the laws LIGGGHTS's hertz and tangential history apply; `compliance material` uses them.
+//     the laws LIGGGHTS's hertz and tangential history apply; `compliance material` uses them,
+//     with hertz's dashpots (their rebound is coefficientRestitution).
 // Mesh walls have a type of their own (fix mesh/surface ... type T), so a wall contact takes
 // the pair (sphere type, T) as native LIGGGHTS does.
 #include <cmath>
@@ -118,6 +119,9 @@ PairReading read_pair_coefficients(LAMMPS_NS::LAMMPS *lmp)
           p.tangential = fibre::TangentialLaw::mindlin;
           p.k_t = 8.0 * g_eff;
         }
+        // LIGGGHTS's hertz normal dashpot
+        const double e = p.restitution;
+        if (e > 0 && e < 1) p.damping_alpha = fibre::liggghts_hertz_damping(e);
       }
     }
   out.table = std::move(table);

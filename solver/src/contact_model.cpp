@@ -62,17 +62,37 @@ void apply_pair(const ContactModel &model, const PairCoefficients &pc, const Spo
   const std::array<double, kMaxRows> rigid = c.compliance;
   material_compliance(pc, reff, overlap, force, rigid, c.compliance, c.elastic);
   for (int r = rows; r < kMaxRows; ++r) c.elastic[r] = false;
-  // Soft contacts get at least critical damping, tau = 2 sqrt(m_eff eps) (SPOOK's d = 2
-  // would leave a Hertz column ringing): at rest they sit still, bounces come from e.
+  // A loaded contact's normal row is a Kelvin-Voigt element with the law's own dashpot (damping
+  // time gamma_n / k), at least SPOOK's d, below which a contact stiffer than the step rings. A
+  // law without a dashpot is damped critically, tau = 2 sqrt(m_eff eps). Its springs keep at
+  // least that critical damping (below). Bounces come from e (doc/design.md, session 17).
   const double ma = bodies[c.a].mass;
   const double m_eff = c.is_wall() ? ma : ma * bodies[c.b].mass / (ma + bodies[c.b].mass);
-  const double critical = 2.0 * std::sqrt(m_eff * c.compliance[0]) / h;
-  if (critical > model.damping) c.damping = critical;
-  // The SDS rolling and twisting springs carry the law's own damper (SPOOK's damping time is
-  // the Kelvin-Voigt element's gamma / k), at least the contact's: two steps, below which a
-  // spring stiffer than the step rings, or a soft loaded contact's critical damping, without
-  // which a pile at rest rocks on its rolling springs (doc/design.md, session 15).
-  const double floor = std::max(model.damping, c.damping);
+  double critical = 0.0; // the normal row's, in steps
+  if (c.elastic[0]) {
+    const double a = std::sqrt(reff * overlap);
+    double gamma_n = normal_damper(pc, m_eff, a, 1.0 / c.compliance[0]);
+    // Where the law's dashpot acts over more than SPOOK's d steps, the step resolves the
+    // contact: its secant is the law's at the overlap, as LAMMPS's, not at the last step's
+    // force, which held the dashpot's force too (on a swing, a stiffer spring).
+    if (gamma_n * c.compliance[0] > model.damping * h && overlap > 0) {
+      material_compliance(pc, reff, overlap, 0.0, rigid, c.compliance, c.elastic);
+      for (int r = rows; r < kMaxRows; ++r) c.elastic[r] = false;
+      gamma_n = normal_damper(pc, m_eff, a, 1.0 / c.compliance[0]);
+    }
+    const double eps = c.compliance[0];
+    critical = 2.0 * std::sqrt(m_eff * eps) / h;
+    const double tau_n = gamma_n >= 0 ? gamma_n * eps : critical * h;
+    if (tau_n / h > model.damping) c.damping = tau_n / h;
+  }
+  // The springs take at least the contact's damping and the normal row's critical damping:
+  // below it a pile at rest rocks on its rolling springs (session 15), and a sphere that a
+  // bowl's rolling resistance stops rolls back up (session 17). The SDS rolling and twisting
+  // springs carry the law's own damper (SPOOK's damping time is the Kelvin-Voigt element's
+  // gamma / k) where that is longer (doc/design.md, session 15).
+  const double floor = std::max({model.damping, c.damping, critical});
+  for (int r = 1; r <= 2 && r < rows; ++r)
+    if (c.elastic[r] && floor > std::max(model.damping, c.damping)) c.spring_damping[r] = floor;
   for (int r = 3; r < rows; ++r) {
     const double tau = spring_damping_time(pc, r);
     if (c.elastic[r] && tau > 0) {
@@ -106,6 +126,7 @@ void apply_contact_model(const ContactModel &model, const SpookParams &params, d
     c.friction = model.friction;
     c.restitution = model.restitution;
     c.elastic.fill(false);
+    c.damping = -1.0;
     c.spring_damping.fill(-1.0);
     c.damper_time.fill(0.0);
     const int ta = bodies[c.a].type;

@@ -58,6 +58,10 @@ std::string MaterialTable::mix()
       p.k_twist = geom(a.k_twist, b.k_twist);
       p.gamma_roll = geom(a.gamma_roll, b.gamma_roll);
       p.gamma_twist = geom(a.gamma_twist, b.gamma_twist);
+      if (a.viscous != b.viscous)
+        return "types " + pair + ": different normal damping models cannot mix";
+      p.viscous = a.viscous;
+      p.viscous_coeff = geom(a.viscous_coeff, b.viscous_coeff);
       // LAMMPS mixes Tsuji's alpha; the rebound then follows from the mixed law
       p.limit_damping = a.limit_damping || b.limit_damping;
       if (a.damping_alpha >= 0 && b.damping_alpha >= 0) {
@@ -188,6 +192,28 @@ double collision_time(const PairCoefficients &p, double r_eff, double m_eff, dou
   return 2.0 * half_period * d_max / v;
 }
 
+double liggghts_hertz_damping(double e)
+{
+  const double ln = std::log(e), pi = std::acos(-1.0);
+  return std::sqrt(5.0) * std::fabs(ln) / std::sqrt(ln * ln + pi * pi);
+}
+
+double normal_damper(const PairCoefficients &p, double m_eff, double a, double k)
+{
+  if (p.damping_alpha >= 0) return p.damping_alpha * std::sqrt(m_eff * k);
+  switch (p.viscous) {
+  case ViscousDamping::velocity:
+    return p.viscous_coeff;
+  case ViscousDamping::mass_velocity:
+    return p.viscous_coeff * m_eff;
+  case ViscousDamping::viscoelastic:
+    return p.viscous_coeff * m_eff * a;
+  case ViscousDamping::none:
+    break;
+  }
+  return -1.0;
+}
+
 double spring_damping_time(const PairCoefficients &p, int r)
 {
   if ((r == 4 || r == 5) && p.k_roll > 0 && p.gamma_roll > 0) return p.gamma_roll / p.k_roll;
@@ -210,7 +236,7 @@ std::vector<std::string> MaterialTable::describe() const
                                               : std::string("none");
       line += ", restitution " + (p.restitution >= 0 ? g(p.restitution) : std::string("none"));
       if (p.damping_alpha >= 0)
-        line += " (the rebound of damping tsuji, alpha " + g(p.damping_alpha) + ")";
+        line += " (the rebound of the damped Hertz or Hooke law, alpha " + g(p.damping_alpha) + ")";
       lines.push_back(line);
     }
   return lines;

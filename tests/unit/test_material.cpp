@@ -375,6 +375,83 @@ TEST(Material, RollingSpringsCarryTheirDamperFromTheFirstStep)
   EXPECT_DOUBLE_EQ(contacts[0].spring_damping[4], model.damping);
 }
 
+// The normal dashpots of LAMMPS's damping models (pair granular: tsuji on the secant k_n a,
+// velocity, mass_velocity, viscoelastic) and LIGGGHTS's hertz, whose law rebounds at its e.
+TEST(Material, NormalDampersOfTheDampingModels)
+{
+  PairCoefficients p = hertz_material_pair();
+  const double m = 0.3, a = 0.02, k = 5e3;
+  EXPECT_LT(normal_damper(p, m, a, k), 0.0); // no law
+  p.viscous = ViscousDamping::velocity;
+  p.viscous_coeff = 2.0;
+  EXPECT_DOUBLE_EQ(normal_damper(p, m, a, k), 2.0);
+  p.viscous = ViscousDamping::mass_velocity;
+  EXPECT_DOUBLE_EQ(normal_damper(p, m, a, k), 2.0 * m);
+  p.viscous = ViscousDamping::viscoelastic;
+  EXPECT_DOUBLE_EQ(normal_damper(p, m, a, k), 2.0 * m * a);
+  p.damping_alpha = tsuji_damping(0.1); // tsuji: the viscous model is then not LAMMPS's
+  EXPECT_DOUBLE_EQ(normal_damper(p, m, a, k), p.damping_alpha * std::sqrt(m * k));
+  for (double e : {0.1, 0.3, 0.5, 0.9})
+    EXPECT_NEAR(rebound_restitution(NormalLaw::hertz, liggghts_hertz_damping(e)), e, 2e-3 * e) << e;
+  // unlike types mix geometrically, as LAMMPS mixes its damping coefficients
+  MaterialTable t(2);
+  for (int i : {1, 2}) {
+    t.at(i, i) = hertz_material_pair();
+    t.at(i, i).viscous = ViscousDamping::viscoelastic;
+    t.at(i, i).viscous_coeff = i * 1.0;
+  }
+  ASSERT_EQ(t.mix(), "");
+  EXPECT_DOUBLE_EQ(t.at(1, 2).viscous_coeff, std::sqrt(2.0));
+  t.at(2, 2).viscous = ViscousDamping::velocity;
+  t.at(1, 2).set = false;
+  EXPECT_NE(t.mix(), "");
+}
+
+// A loaded contact's normal row takes the law's dashpot as its damping time (gamma_n / k_n)
+// where that is longer than SPOOK's d steps, and d where the step is too large for it; its
+// tangential springs keep the normal row's critical damping.
+TEST(Material, LoadedContactsTakeTheLawsDashpot)
+{
+  std::vector<Body> bodies(1);
+  bodies[0].type = 1;
+  bodies[0].mass = 0.2;
+  bodies[0].radius = 0.25;
+  std::vector<Contact> contacts(1);
+  contacts[0].a = 0; // a wall contact, loaded
+  contacts[0].gap = -1e-3;
+  ContactModel model;
+  model.compliance.automatic = false;
+  model.compliance.material = true;
+  model.rows = 3;
+  model.materials = MaterialTable(1);
+  PairCoefficients p = hertz_material_pair();
+  p.tangential = TangentialLaw::mindlin;
+  p.k_t = 6e4;
+  p.damping_alpha = tsuji_damping(0.3);
+  model.materials.at(1, 1) = p;
+  const double r = 0.25, d = 1e-3, k_n = p.k_n * std::sqrt(r * d);
+  const double gamma_n = p.damping_alpha * std::sqrt(0.2 * k_n);
+  Vector last = Vector::Constant(3, 0.0);
+  for (const double h : {1e-4, 1e-2}) {
+    last[0] = 2.0 * k_n * d * h; // the last step's force held a dashpot's: not the reference
+    apply_contact_model(model, step_of(h), 1.0, bodies, contacts, &last);
+    const Contact &c = contacts[0];
+    ASSERT_TRUE(c.elastic[0] && c.elastic[1]);
+    if (h == 1e-4) { // resolved: the law's secant at the overlap, and its dashpot
+      EXPECT_NEAR(1.0 / c.compliance[0], k_n, 1e-9 * k_n);
+      EXPECT_NEAR(c.damping, gamma_n / k_n / h, 1e-9 * c.damping);
+      EXPECT_GT(c.damping, model.damping);
+    } else { // the dashpot acts within less than d steps: SPOOK's d, at the last force
+      EXPECT_LT(c.damping, 0.0);
+      EXPECT_GT(1.0 / c.compliance[0], 1.2 * k_n);
+    }
+    // the tangential springs at least at the normal row's critical damping
+    const double critical = 2.0 * std::sqrt(0.2 * c.compliance[0]) / h;
+    EXPECT_NEAR(c.spring_damping[1], critical, 1e-9 * critical);
+    EXPECT_EQ(c.spring_damping[2], c.spring_damping[1]);
+  }
+}
+
 // The collision time of the elastic laws against the collision integrated by RK4 (m d'' = -F(d)
 // from d = 0 at the approach speed until the overlap closes again).
 TEST(Material, CollisionTimeOfTheElasticLaws)

@@ -337,6 +337,76 @@ TEST(ContactSolver, RollingSphereSlowsAtTheConesRate)
   EXPECT_NEAR(bodies[0].omega.y() * r, bodies[0].v.x(), 1e-6); // still rolling
 }
 
+// A loaded Hertz contact resolved by the step (omega h = 0.07) is the pair style's damped law:
+// a sphere resting on the floor, pushed down at 0.05 m/s, swings to the overlaps that LAMMPS's
+// law F = k_n a d + alpha sqrt(m k_n a) d' (damping tsuji, e = 0.5; a = sqrt(r d)) gives,
+// integrated by RK4. Critical damping in its place (the rule before session 17) leaves 40% of
+// the swing and 1% of the rebound; the secant at the last step's force, which holds the
+// dashpot's force too, 94% of both.
+TEST(ContactSolver, LoadedHertzContactSwingsAsTheDampedLaw)
+{
+  const double m = 0.2, r = 0.25, v0 = 0.05, t_end = 0.12;
+  PairCoefficients law;
+  law.set = true;
+  law.normal = NormalLaw::hertz_material;
+  law.k_n = 5e4;
+  law.damping_alpha = tsuji_damping(0.5);
+  law.restitution = rebound_restitution(NormalLaw::hertz, law.damping_alpha);
+  const double weight = m * kG;
+  const double d_eq = std::cbrt(weight * weight / (law.k_n * law.k_n * r));
+  // reference: the overlap's first maximum and the minimum after it
+  const auto accel = [&](double d, double dd) {
+    const double k = law.k_n * std::sqrt(r * std::max(d, 0.0));
+    return (weight - k * d - law.damping_alpha * std::sqrt(m * k) * dd) / m;
+  };
+  double d = d_eq, dd = v0, ref_max = d, ref_min = INFINITY;
+  const double dt = 1e-6;
+  for (double t = 0; t < t_end; t += dt) {
+    const double k1 = accel(d, dd), v1 = dd;
+    const double k2 = accel(d + 0.5 * dt * v1, dd + 0.5 * dt * k1), v2 = dd + 0.5 * dt * k1;
+    const double k3 = accel(d + 0.5 * dt * v2, dd + 0.5 * dt * k2), v3 = dd + 0.5 * dt * k2;
+    const double k4 = accel(d + dt * v3, dd + dt * k3), v4 = dd + dt * k3;
+    d += dt / 6 * (v1 + 2 * v2 + 2 * v3 + v4);
+    dd += dt / 6 * (k1 + 2 * k2 + 2 * k3 + k4);
+    if (dd > 0 && ref_min == INFINITY) ref_max = std::max(ref_max, d);
+    if (dd <= 0 || ref_min < INFINITY) ref_min = std::min(ref_min, d);
+  }
+  ContactModel model;
+  model.compliance.automatic = false;
+  model.compliance.material = true;
+  model.rows = 3;
+  model.materials = MaterialTable(1);
+  model.materials.at(1, 1) = law;
+  std::vector<Body> bodies{sphere(m, r, Vec3(0, 0, r - d_eq))};
+  bodies[0].type = 1;
+  bodies[0].v.z() = -v0;
+  Vector last = Vector::Constant(3, 0.0);
+  last[0] = weight * kH;
+  StepOptions o = base_options();
+  o.stop.tol = 1e-10;
+  double fix_max = d_eq, fix_min = INFINITY, damping = 0.0;
+  for (double t = 0; t < t_end; t += kH) {
+    std::vector<Contact> contacts{sphere_wall_contact(bodies, 0, Vec3::UnitZ(), bodies[0].x.z())};
+    apply_contact_model(model, spook(), m, bodies, contacts, &last);
+    damping = std::max(damping, contacts[0].damping);
+    ContactSystem sys(bodies, contacts, 3, spook());
+    const StepResult res = solve(sys, o);
+    ASSERT_TRUE(res.converged);
+    last = res.lambda;
+    bodies[0].v += kH * bodies[0].force / m + res.dv.head<3>();
+    bodies[0].x += kH * bodies[0].v;
+    const double overlap = r - bodies[0].x.z();
+    if (bodies[0].v.z() < 0 && fix_min == INFINITY) fix_max = std::max(fix_max, overlap);
+    if (bodies[0].v.z() >= 0 || fix_min < INFINITY) fix_min = std::min(fix_min, overlap);
+  }
+  // the law's damping time, alpha sqrt(m eps), is several steps here: above SPOOK's floor
+  EXPECT_GT(damping, 2.0);
+  const double swing = ref_max - d_eq, rebound = d_eq - ref_min;
+  ASSERT_GT(rebound, 0.2 * swing); // lively enough to tell the damping apart
+  EXPECT_NEAR(fix_max - d_eq, swing, 0.01 * swing);
+  EXPECT_NEAR(d_eq - fix_min, rebound, 0.01 * rebound);
+}
+
 // max_recovery bounds the removal of a rigid row's overlap, not the force of a material one.
 // A sphere pressed 4x deeper into the floor than Hertz's overlap under its weight, with the
 // material's secant compliance (compliance material) and a recovery speed that would cap the

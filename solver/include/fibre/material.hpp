@@ -26,6 +26,7 @@ enum class TwistLaw { none, sds, marshall };
 //               marshall: 0.5 k_t a^2 (mindlin).
 enum class NormalLaw { none, hooke, hertz, hertz_material };
 enum class TangentialLaw { none, linear, mindlin };
+enum class ViscousDamping { none, velocity, mass_velocity, viscoelastic };
 
 struct PairCoefficients {
   bool set = false;
@@ -38,7 +39,13 @@ struct PairCoefficients {
   // With LAMMPS's damping tsuji it is the rebound of the pair style's own damped law
   // (rebound_restitution), not the e typed in pair_coeff.
   double restitution = -1.0;
-  double damping_alpha = -1.0;        // LAMMPS's damping tsuji: its coefficient alpha (< 0: none)
+  // The normal dashpot alpha sqrt(m_eff k_n a) of LAMMPS's damping tsuji (its coefficient) and
+  // of LIGGGHTS's hertz (alpha = sqrt(5) |ln e| / sqrt(ln^2 e + pi^2)); < 0: none.
+  double damping_alpha = -1.0;
+  // LAMMPS's viscous normal damping models (pair granular's damping velocity, mass_velocity,
+  // viscoelastic, the last its default): the dashpot c, c m_eff or c m_eff a (normal_damper).
+  ViscousDamping viscous = ViscousDamping::none;
+  double viscous_coeff = 0.0;
   bool limit_damping = false;         // LAMMPS's limit_damping: the normal force never pulls
   NormalLaw normal = NormalLaw::none; // none: no elastic constants (compliance auto)
   double k_n = 0.0;
@@ -80,6 +87,11 @@ class MaterialTable {
 double tsuji_damping(double e);
 double restitution_from_tsuji(double alpha);
 
+// LIGGGHTS's hertz dashpot for a coefficient of restitution e in (0, 1), in the form
+// alpha sqrt(m_eff k_n a) of normal_damper: alpha = sqrt(5) |ln e| / sqrt(ln^2 e + pi^2) (its
+// gamma = 2 sqrt(5/6) |beta| sqrt(S m_eff) on S = 2 Y* a, 1.5 the secant). It rebounds at e.
+double liggghts_hertz_damping(double e);
+
 // The coefficient of restitution that a head-on collision under LAMMPS's damped normal law
 // gives: overlap d, hooke F = k d + alpha sqrt(m k) d', hertz F = k a d + alpha sqrt(m k a) d'
 // with a = sqrt(r_eff d) (damping tsuji). The law is scale free, so this depends on alpha
@@ -113,6 +125,12 @@ bool material_compliance(const PairCoefficients &p, double r_eff, double overlap
 // (F = K d^3/2, K = k_n sqrt(r_eff)) 2.94 d_max / v with the deepest overlap
 // d_max = (5 m_eff v^2 / (4 K))^2/5. 0 where p has no normal law.
 double collision_time(const PairCoefficients &p, double r_eff, double m_eff, double v);
+
+// The normal law's dashpot gamma_n (force per unit approach speed) of a contact of reduced mass
+// m_eff, contact radius a and secant stiffness k (the normal row's 1 / eps), as LAMMPS damps
+// it: tsuji alpha sqrt(m_eff k), velocity c, mass_velocity c m_eff, viscoelastic c m_eff a.
+// < 0 where the pair has no damping law.
+double normal_damper(const PairCoefficients &p, double m_eff, double a, double k);
 
 // The damping time (seconds) of row r's spring in the pair's law, gamma / k of the SDS rolling
 // (rows 4, 5) and twisting (row 3) laws; 0 where the law has no damper of its own.
