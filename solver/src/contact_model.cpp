@@ -70,17 +70,8 @@ void apply_pair(const ContactModel &model, const PairCoefficients &pc, const Spo
   const double m_eff = c.is_wall() ? ma : ma * bodies[c.b].mass / (ma + bodies[c.b].mass);
   double critical = 0.0; // the normal row's, in steps
   if (c.elastic[0]) {
-    const double a = std::sqrt(reff * overlap);
-    double gamma_n = normal_damper(pc, m_eff, a, 1.0 / c.compliance[0]);
-    // Where the law's dashpot acts over more than SPOOK's d steps, the step resolves the
-    // contact: its secant is the law's at the overlap, as LAMMPS's, not at the last step's
-    // force, which held the dashpot's force too (on a swing, a stiffer spring).
-    if (gamma_n * c.compliance[0] > model.damping * h && overlap > 0) {
-      material_compliance(pc, reff, overlap, 0.0, rigid, c.compliance, c.elastic);
-      for (int r = rows; r < kMaxRows; ++r) c.elastic[r] = false;
-      gamma_n = normal_damper(pc, m_eff, a, 1.0 / c.compliance[0]);
-    }
     const double eps = c.compliance[0];
+    const double gamma_n = normal_damper(pc, m_eff, std::sqrt(reff * overlap), 1.0 / eps);
     critical = 2.0 * std::sqrt(m_eff * eps) / h;
     const double tau_n = gamma_n >= 0 ? gamma_n * eps : critical * h;
     if (tau_n / h > model.damping) c.damping = tau_n / h;

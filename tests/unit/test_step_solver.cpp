@@ -340,9 +340,10 @@ TEST(ContactSolver, RollingSphereSlowsAtTheConesRate)
 // A loaded Hertz contact resolved by the step (omega h = 0.07) is the pair style's damped law:
 // a sphere resting on the floor, pushed down at 0.05 m/s, swings to the overlaps that LAMMPS's
 // law F = k_n a d + alpha sqrt(m k_n a) d' (damping tsuji, e = 0.5; a = sqrt(r d)) gives,
-// integrated by RK4. Critical damping in its place (the rule before session 17) leaves 40% of
-// the swing and 1% of the rebound; the secant at the last step's force, which holds the
-// dashpot's force too, 94% of both.
+// integrated by RK4, within 8%. Critical damping in its place (the rule before session 17)
+// leaves 40% of the swing and 1% of the rebound. What is left (6% short) is the secant at the
+// last step's force, which holds the dashpot's force too: at the overlap alone it was within
+// 0.3%, but a sphere at rest on an obstacle then crept (doc/design.md, session 17).
 TEST(ContactSolver, LoadedHertzContactSwingsAsTheDampedLaw)
 {
   const double m = 0.2, r = 0.25, v0 = 0.05, t_end = 0.12;
@@ -403,8 +404,8 @@ TEST(ContactSolver, LoadedHertzContactSwingsAsTheDampedLaw)
   EXPECT_GT(damping, 2.0);
   const double swing = ref_max - d_eq, rebound = d_eq - ref_min;
   ASSERT_GT(rebound, 0.2 * swing); // lively enough to tell the damping apart
-  EXPECT_NEAR(fix_max - d_eq, swing, 0.01 * swing);
-  EXPECT_NEAR(d_eq - fix_min, rebound, 0.01 * rebound);
+  EXPECT_NEAR(fix_max - d_eq, swing, 0.08 * swing);
+  EXPECT_NEAR(d_eq - fix_min, rebound, 0.08 * rebound);
 }
 
 // max_recovery bounds the removal of a rigid row's overlap, not the force of a material one.
