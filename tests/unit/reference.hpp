@@ -4,6 +4,7 @@
 
 #include <Eigen/Dense>
 #include <algorithm>
+#include <utility>
 
 #include "fibre/system.hpp"
 
@@ -92,6 +93,19 @@ inline Dense dense_K(const ContactSystem &sys)
   Dense K = G.transpose() * dense_sigma(sys).cwiseInverse().asDiagonal() * G;
   K.diagonal() += dense_Minv(sys).diagonal().cwiseInverse();
   return K;
+}
+
+// One classical Runge-Kutta step of d'' = accel(d, d') from (d, u): the next (d, u). The tests'
+// reference for a contact law's collision, apart from the library's own integration.
+template <typename Accel>
+std::pair<double, double> rk4_step(double d, double u, double dt, const Accel &accel)
+{
+  const double k1d = u, k1u = accel(d, u);
+  const double k2d = u + 0.5 * dt * k1u, k2u = accel(d + 0.5 * dt * k1d, k2d);
+  const double k3d = u + 0.5 * dt * k2u, k3u = accel(d + 0.5 * dt * k2d, k3d);
+  const double k4d = u + dt * k3u, k4u = accel(d + dt * k3d, k4d);
+  return {d + dt / 6.0 * (k1d + 2.0 * k2d + 2.0 * k3d + k4d),
+          u + dt / 6.0 * (k1u + 2.0 * k2u + 2.0 * k3u + k4u)};
 }
 
 } // namespace fibre::test

@@ -5,9 +5,11 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <tuple>
 
 #include "fibre/contact_model.hpp"
 #include "fibre/material.hpp"
+#include "reference.hpp"
 
 using namespace fibre;
 
@@ -462,17 +464,15 @@ TEST(Material, CollisionTimeOfTheElasticLaws)
       p.normal = law;
       const double K = law == NormalLaw::hooke ? p.k_n : p.k_n * std::sqrt(r_eff);
       const double power = law == NormalLaw::hooke ? 1.0 : 1.5;
-      const auto accel = [&](double d) { return -K * std::pow(std::max(d, 0.0), power) / m_eff; };
+      const auto accel = [&](double d, double) {
+        return -K * std::pow(std::max(d, 0.0), power) / m_eff;
+      };
       const double t_c = collision_time(p, r_eff, m_eff, v);
       const double dt = t_c / 2e5;
       double d = 0.0, u = v, t = 0.0;
       while (true) {
-        const double k1d = u, k1u = accel(d);
-        const double k2d = u + 0.5 * dt * k1u, k2u = accel(d + 0.5 * dt * k1d);
-        const double k3d = u + 0.5 * dt * k2u, k3u = accel(d + 0.5 * dt * k2d);
-        const double k4d = u + dt * k3u, k4u = accel(d + dt * k3d);
-        const double d_next = d + dt / 6.0 * (k1d + 2.0 * k2d + 2.0 * k3d + k4d);
-        u += dt / 6.0 * (k1u + 2.0 * k2u + 2.0 * k3u + k4u);
+        double d_next;
+        std::tie(d_next, u) = fibre::test::rk4_step(d, u, dt, accel);
         if (t > 0 && d_next <= 0.0) {
           t += dt * d / (d - d_next);
           break;

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <tuple>
 #include <limits>
 
 #include "fibre/material.hpp"
@@ -363,12 +364,7 @@ TEST(ContactSolver, LoadedHertzContactSwingsAsTheDampedLaw)
   double d = d_eq, dd = v0, ref_max = d, ref_min = INFINITY;
   const double dt = 1e-6;
   for (double t = 0; t < t_end; t += dt) {
-    const double k1 = accel(d, dd), v1 = dd;
-    const double k2 = accel(d + 0.5 * dt * v1, dd + 0.5 * dt * k1), v2 = dd + 0.5 * dt * k1;
-    const double k3 = accel(d + 0.5 * dt * v2, dd + 0.5 * dt * k2), v3 = dd + 0.5 * dt * k2;
-    const double k4 = accel(d + dt * v3, dd + dt * k3), v4 = dd + dt * k3;
-    d += dt / 6 * (v1 + 2 * v2 + 2 * v3 + v4);
-    dd += dt / 6 * (k1 + 2 * k2 + 2 * k3 + k4);
+    std::tie(d, dd) = fibre::test::rk4_step(d, dd, dt, accel);
     if (dd > 0 && ref_min == INFINITY) ref_max = std::max(ref_max, d);
     if (dd <= 0 || ref_min < INFINITY) ref_min = std::min(ref_min, d);
   }
