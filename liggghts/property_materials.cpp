@@ -121,7 +121,7 @@ PairReading read_pair_coefficients(LAMMPS_NS::LAMMPS *lmp)
         }
         // LIGGGHTS's hertz normal dashpot
         const double e = p.restitution;
-        if (e > 0 && e < 1) p.damping_alpha = fibre::liggghts_hertz_damping(e);
+        if (e > 0 && e <= 1) p.damping_alpha = fibre::liggghts_hertz_damping(e);
       }
     }
   out.table = std::move(table);

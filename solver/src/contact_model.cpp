@@ -81,9 +81,10 @@ void apply_pair(const ContactModel &model, const PairCoefficients &pc, const Spo
   // bowl's rolling resistance stops rolls back up (session 17). The SDS rolling and twisting
   // springs carry the law's own damper (SPOOK's damping time is the Kelvin-Voigt element's
   // gamma / k) where that is longer (doc/design.md, session 15).
-  const double floor = std::max({model.damping, c.damping, critical});
+  const double contact_d = std::max(model.damping, c.damping);
+  const double floor = std::max(contact_d, critical);
   for (int r = 1; r <= 2 && r < rows; ++r)
-    if (c.elastic[r] && floor > std::max(model.damping, c.damping)) c.spring_damping[r] = floor;
+    if (c.elastic[r] && floor > contact_d) c.spring_damping[r] = floor;
   for (int r = 3; r < rows; ++r) {
     const double tau = spring_damping_time(pc, r);
     if (c.elastic[r] && tau > 0) {

@@ -5,6 +5,7 @@ MPI, restart and bad input, against analytic references.
   Hertz's d = (3 m g / (4 Y* sqrt(r)))^(2/3), Y* from youngsModulus and poissonsRatio of the
   sphere's type and the mesh's type (within 1%), with the default (the material's
   compliance) and typed alike; rigid rows (`compliance auto`) keep it below 1e-4 r.
+- The normal dashpot from coefficientRestitution e is LIGGGHTS's hertz one, also at e = 1.
 - An inclined mesh plane: a sphere rolls without slipping at a = 5/7 g sin(theta) when
   tan(theta) < 7/2 mu, and slides at a = g (sin(theta) - mu cos(theta)) above (within 2%); mu
   is the coefficientFriction of the pair (sphere type, mesh type).
@@ -131,6 +132,27 @@ def rest_on_floor(args, checks):
         checks.check(abs(run.last("fc[1][3]") + mass() * G) < 1e-3 * mass() * G and
                      abs(run.last("fc[1][1]")) < 1e-9, "the mesh's load f_fc[1][3] is -m g",
                      "%.9g vs %.9g" % (run.last("fc[1][3]"), -mass() * G))
+
+
+def restitution_dashpot(args, checks):
+    """LIGGGHTS's hertz dashpot from coefficientRestitution: alpha = sqrt(5) |ln e| /
+    sqrt(ln^2 e + pi^2), and at e = 1 none (alpha 0), not the critical damping of a law
+    without a dashpot."""
+    stl(args.workdir + "/floor_e.stl", square(0.05))
+    for e in (0.3, 1.0):
+        deck = header("-0.05 0.05 -0.05 0.05 -0.01 0.05", restitution=e) + one_sphere(0, 0, R) + [
+            "timestep 0.0005", "fix floor all mesh/surface file floor_e.stl type 2",
+            "fix fc all fibre_contact wall mesh floor", "run 0"]
+        run = e2e.run_lmp(args, "\n".join(deck) + "\n", "dashpot_%g" % e)
+        if not checks.ran(run):
+            continue
+        ln = math.log(e)
+        alpha = math.sqrt(5.0) * abs(ln) / math.sqrt(ln * ln + math.pi ** 2)
+        logged = [float(line.split("alpha ")[1].rstrip(")"))
+                  for line in run.output.splitlines() if "1 2: mu" in line and "alpha " in line]
+        checks.check(logged and all(abs(x - alpha) <= 1e-5 * max(alpha, 1e-6) for x in logged),
+                     "coefficientRestitution %g: the hertz dashpot alpha %.6g" % (e, alpha),
+                     "logged %s" % logged)
 
 
 def incline(args, checks):
@@ -296,6 +318,7 @@ def main():
     args = e2e.parse_args()
     checks = e2e.Checks("LIGGGHTS front end: mesh walls, materials, MPI, restart, bad input")
     rest_on_floor(args, checks)
+    restitution_dashpot(args, checks)
     incline(args, checks)
     conveyor(args, checks)
     cube_drop(args, checks)
