@@ -144,17 +144,27 @@ advance_springs(const ContactSystem &sys, const Vector &v_plus, const Vector &la
       const Cone &rows_of = kCones[cone];
       if (!k.elastic[rows_of.first]) continue;
       Eigen::Vector2d xi = Eigen::Vector2d::Zero(), l = Eigen::Vector2d::Zero();
+      Eigen::Vector2d w = Eigen::Vector2d::Zero(); // the rows' velocity at the step's end
       for (int i = 0; i < rows_of.size; ++i) {
         const int r = rows_of.first + i;
-        xi[i] = k.spring[r] + h * (Gv[base + r] - wall[r]);
+        w[i] = Gv[base + r] - wall[r];
+        xi[i] = k.spring[r] + h * w[i];
         if (lambda.size() == sys.contact_dofs()) l[i] = lambda[base + r];
       }
-      // the spring force |xi| / eps may not exceed the cone's radius per unit time
+      // The law's force, spring and damper together, -(xi + tau w) / eps, may not exceed the
+      // cone's radius per unit time. A spring that pushes along the motion while its damper
+      // holds the sum inside the cone is not at its limit: it unloads as the contact moves.
+      // (Tested on the spring alone, that spring was put back at the cone every step and drove
+      // a sphere back up an obstacle; doc/design.md, session 18.)
       const double eps = k.compliance[rows_of.first];
       const double limit = eps * cones.coeff(c, cone) * lambda_n / h;
-      if (xi.norm() > limit) {
-        const double ln = l.norm();
-        xi = ln > 0 ? Eigen::Vector2d(-limit / ln * l) : Eigen::Vector2d(limit / xi.norm() * xi);
+      const double tau = k.damper_time[rows_of.first];
+      if ((xi + tau * w).norm() > limit) {
+        const double ln = l.norm(), xn = xi.norm();
+        if (ln > 0)
+          xi = -limit / ln * l;
+        else if (xn > limit)
+          xi *= limit / xn;
         // A spring with a damper of its own (SDS rolling, twisting) keeps, as LAMMPS's, the
         // cone's force less the damper's (tau w): the two together are the cone's. Where the
         // damper alone exceeds the cone, the spring then pushes along the motion. tau is the
@@ -162,15 +172,11 @@ advance_springs(const ContactSystem &sys, const Vector &v_plus, const Vector &la
         // that slows by s a step, SPOOK's next force is -k (xi + d h w - h (1 + 4 d) s / 4):
         // the spring keeps that last share back, or a rolling sphere falls short of the cone's
         // torque (by 13% at the decks' step).
-        const double tau = k.damper_time[rows_of.first];
         if (ln > 0 && tau > 0) {
           if (Gv0.size() == 0) g_apply(sys, body_velocities(sys), Gv0);
-          Eigen::Vector2d w = Eigen::Vector2d::Zero(), w0 = Eigen::Vector2d::Zero();
-          for (int i = 0; i < rows_of.size; ++i) {
-            const int r = rows_of.first + i;
-            w[i] = Gv[base + r] - wall[r];
-            w0[i] = Gv0[base + r] - wall[r];
-          }
+          Eigen::Vector2d w0 = Eigen::Vector2d::Zero();
+          for (int i = 0; i < rows_of.size; ++i)
+            w0[i] = Gv0[base + rows_of.first + i] - wall[rows_of.first + i];
           const double speed = w.norm();
           if (speed > 0) {
             const double d = sys.params().damping_of(k, rows_of.first);

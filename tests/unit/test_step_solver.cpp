@@ -307,6 +307,54 @@ TEST(ContactSolver, RollingSpringAtTheConeKeepsTheConeLessItsDamper)
   }
 }
 
+// LAMMPS's SDS law rescales its history where the law's force, spring and damper together,
+// exceeds the cone. A sphere on the floor rolls the way its loaded rolling spring pushes it
+// (1.2 times the cone's displacement), slowly enough that the damper (tau = 10 ms) holds the
+// sum inside the cone: the spring is not at its limit and unloads by h G v+. Rescaled on the
+// spring alone it went back to the cone every step and kept pushing: a sphere on an obstacle
+// then rolled back uphill (doc/design.md, session 18).
+TEST(ContactSolver, RollingSpringPushingAlongTheMotionUnloads)
+{
+  const double m = 1.5, r = 0.4, mu_roll = 0.1, tau = 10e-3;
+  const double k_roll = 1e3 * r * r;
+  const double cone = mu_roll * r * m * kG / k_roll; // the cone's displacement under the weight
+  std::vector<Body> bodies{sphere(m, r, Vec3(0, 0, r))};
+  Contact contact = sphere_wall_contact(bodies, 0, Vec3::UnitZ(), r);
+  contact.compliance.fill(1e-14);
+  contact.compliance[4] = contact.compliance[5] = 1.0 / k_roll;
+  contact.elastic[4] = contact.elastic[5] = true;
+  contact.spring_damping[4] = contact.spring_damping[5] = tau / kH;
+  contact.damper_time[4] = contact.damper_time[5] = tau;
+  contact.friction = FrictionParams{10.0, mu_roll, 0.0}; // no sliding
+  // rolling about x at the speed where the damper's force is half the cone's
+  const auto roll = [&](double omega) {
+    bodies[0].omega = Vec3(omega, 0, 0);
+    bodies[0].v = bodies[0].omega.cross(Vec3(0, 0, r)); // the contact point at rest
+  };
+  roll(1.0);
+  Vector Gv0;
+  g_apply(ContactSystem(bodies, {contact}, 6, spook()),
+          body_velocities(ContactSystem(bodies, {contact}, 6, spook())), Gv0);
+  const int row = std::fabs(Gv0[4]) > std::fabs(Gv0[5]) ? 4 : 5;
+  roll(0.5 * cone / tau / Gv0[row]);
+  contact.spring[row] = Gv0[row] > 0 ? -1.2 * cone : 1.2 * cone; // pushing along the motion
+  ContactSystem sys(bodies, {contact}, 6, spook());
+  StepOptions o = base_options();
+  o.stop.tol = 1e-10;
+  const StepResult res = solve(sys, o);
+  ASSERT_TRUE(res.converged);
+  const Vector v_plus = velocities_after(sys, serial_exchange(), res.lambda);
+  Vector Gv;
+  g_apply(sys, v_plus, Gv);
+  const double limit = mu_roll * r * res.lambda[0] / (k_roll * kH);
+  const double moved = contact.spring[row] + kH * Gv[row];
+  ASSERT_GT(std::fabs(moved), limit);                       // the spring alone beyond the cone
+  ASSERT_LT(std::fabs(moved + tau * Gv[row]), 0.9 * limit); // the law's force inside it
+  const std::array<double, kMaxRows> xi = advance_springs(sys, v_plus, res.lambda)[0];
+  EXPECT_NEAR(xi[row], moved, 1e-12 * cone);
+  EXPECT_LT(std::fabs(xi[row]), std::fabs(contact.spring[row])); // unloading
+}
+
 // A sphere rolls along the floor on an SDS rolling spring whose damper (tau = 10 ms) outlasts
 // the step (4 ms, as the decks'): at the cone the torque is mu_roll r m g, and the sphere slows
 // at (5/7) mu_roll g, the analytic rate of a solid sphere. Keeping the damper's share without
