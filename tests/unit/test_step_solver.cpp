@@ -3,8 +3,8 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
-#include <tuple>
 #include <limits>
+#include <tuple>
 
 #include "fibre/material.hpp"
 #include "fibre/spook.hpp"
@@ -333,8 +333,8 @@ TEST(ContactSolver, RollingSpringPushingAlongTheMotionUnloads)
   };
   roll(1.0);
   Vector Gv0;
-  g_apply(ContactSystem(bodies, {contact}, 6, spook()),
-          body_velocities(ContactSystem(bodies, {contact}, 6, spook())), Gv0);
+  const ContactSystem rolling(bodies, {contact}, 6, spook());
+  g_apply(rolling, body_velocities(rolling), Gv0);
   const int row = std::fabs(Gv0[4]) > std::fabs(Gv0[5]) ? 4 : 5;
   roll(0.5 * cone / tau / Gv0[row]);
   contact.spring[row] = Gv0[row] > 0 ? -1.2 * cone : 1.2 * cone; // pushing along the motion
