@@ -10,14 +10,20 @@
 
 namespace fibre {
 
-void PgsResult::record(double change)
+void PgsResult::record(double change, bool full)
 {
-  last_change = change;
   changes.push_back(change);
-  if (changes.size() > std::size_t(kRateWindow)) {
-    const double first = changes[changes.size() - 1 - kRateWindow];
-    contraction = first > 0 ? std::pow(change / first, 1.0 / kRateWindow) : 1.0;
-  }
+  if (!full) return; // focused sweeps: the rate and the estimate follow the full ones
+  last_change = change;
+  const int s = static_cast<int>(changes.size()) - 1;
+  // the latest full sweep at least kRateWindow sweeps back (plain sweeps: exactly that far)
+  for (auto at = full_sweeps.rbegin(); at != full_sweeps.rend(); ++at)
+    if (*at <= s - kRateWindow) {
+      const double first = changes[*at];
+      contraction = first > 0 ? std::pow(change / first, 1.0 / (s - *at)) : 1.0;
+      break;
+    }
+  full_sweeps.push_back(s);
 }
 
 double PgsResult::error_estimate() const
@@ -29,20 +35,22 @@ double PgsResult::error_estimate() const
 
 namespace {
 
-// One sweep over the contacts in order: each moves to lambda_c + (b_c - G_c dv - Sigma_c
-// lambda_c) / scale_c and is projected, and dv follows at once. Returns ||change||^2 and
-// ||lambda||^2 (local). The rows of G are applied in their structured form (contact_rows.hpp).
+// One sweep over the contacts `list` (in order; all of them when null, else `count`): each
+// moves to lambda_c + (b_c - G_c dv - Sigma_c lambda_c) / scale_c and is projected, and dv
+// follows at once. Adds ||change||^2 and ||lambda||^2 (local) of the contacts it visits to
+// norms; with `changes`, it stores each one's change^2 there. The rows of G are applied in
+// their structured form (contact_rows.hpp).
 template <int R>
 void sweep(const ContactSystem &sys, const Cones &cones, const Vector &b,
-           const std::vector<Vec6> &inv_scale, const std::vector<int> &owners, Vector &lambda,
-           Vector &dv, double norms[2])
+           const std::vector<Vec6> &inv_scale, const std::vector<int> &owners, const int *list,
+           int count, Vector &lambda, Vector &dv, double norms[2], double *changes)
 {
-  const int nc = sys.num_contacts();
   const int *pairs = sys.body_pairs();
-  const double *kin = nc > 0 ? sys.kinematics(0).frame.data() : nullptr;
+  const double *kin = sys.num_contacts() > 0 ? sys.kinematics(0).frame.data() : nullptr;
   const double *inv_mass = sys.inv_mass().data(), *sigma = sys.sigma().data();
   double *l = lambda.data(), *w = dv.data();
-  for (int c = 0; c < nc; ++c) {
+  for (int k = 0; k < count; ++k) {
+    const int c = list ? list[k] : k;
     const double *q = kin + 15 * std::size_t(c);
     int ia = pairs[2 * std::size_t(c)], ib = pairs[2 * std::size_t(c) + 1];
     if (!owners.empty()) { // a periodic image moves with its body
@@ -59,11 +67,15 @@ void sweep(const ContactSystem &sys, const Cones &cones, const Vector &b,
       lc[i] += (b[at + i] - u[i] - sigma[at + i] * old[i]) * inv_scale[c][i];
     }
     cones.project_rows<R>(lc, c);
+    double change2 = 0;
     for (int i = 0; i < R; ++i) {
       delta[i] = lc[i] - old[i];
-      norms[0] += delta[i] * delta[i];
+      change2 += delta[i] * delta[i];
       norms[1] += lc[i] * lc[i];
     }
+    norms[0] += change2;
+    if (changes) changes[c] = change2;
+    if (change2 == 0) continue; // an open contact that stays open moves no body
     double ya[6] = {0, 0, 0, 0, 0, 0}, yb[6] = {0, 0, 0, 0, 0, 0};
     contact_impulse<R>(q, q + 9, q + 12, delta, ya, wb ? yb : nullptr);
     const double *ma = inv_mass + 6 * std::size_t(ia);
@@ -73,6 +85,17 @@ void sweep(const ContactSystem &sys, const Cones &cones, const Vector &b,
       for (int d = 0; d < 6; ++d) wb[d] += mb[d] * yb[d];
     }
   }
+}
+
+// The contacts that a full sweep moved by at least kFocusShare of its mean change^2: those
+// left out moved by less than kFocusShare of the sweep's change^2 together.
+constexpr double kFocusShare = 1e-3;
+void focus_list(const std::vector<double> &changes, double total, std::vector<int> &list)
+{
+  list.clear();
+  const double floor = changes.empty() ? 0.0 : kFocusShare * total / double(changes.size());
+  for (std::size_t c = 0; c < changes.size(); ++c)
+    if (changes[c] >= floor) list.push_back(static_cast<int>(c));
 }
 
 } // namespace
@@ -106,16 +129,31 @@ PgsResult pgs(const ContactSystem &sys, const Exchange &ex, const Cones &cones, 
         std::make_unique<FibreBlocks>(sys, ex.local_owners(), cones, control.block_weight, &normal);
   }
   const bool halo = ex.has_halo(); // else the round trip below is the identity
+  const bool focus = control.focus_sweeps > 0 && !control.nonlinear_cg && !blocks;
+  std::vector<double> contact_changes(focus ? nc : 0);
+  std::vector<int> focus_contacts;
   for (int s = 0; s < control.max_sweeps; ++s) {
     // dv follows this process's updates; `moved` collects them for the other processes.
     if (halo) dv_start = dv;
     if (control.nonlinear_cg || s % kCheckpointSweeps == 0) lambda_start = lambda;
     if (blocks) blocks->correct(b, lambda, dv);
     double norms[2] = {0, 0}; // ||change||^2, ||lambda||^2
+    // focused: the first sweep is full, then every (P + 1)-th counted from min_sweeps (so the
+    // rules can stop where plain sweeps would); the P between visit the focus list
+    const int period = control.focus_sweeps + 1;
+    const bool full =
+        !focus || s == 0 || ((s + 1 - control.min_sweeps) % period + period) % period == 0;
+    const int *list = full ? nullptr : focus_contacts.data();
+    const int count = full ? nc : static_cast<int>(focus_contacts.size());
+    double *changes = full && focus ? contact_changes.data() : nullptr;
     if (rows == 6)
-      sweep<6>(sys, cones, b, inv_scale, ex.local_owners(), lambda, dv, norms);
+      sweep<6>(sys, cones, b, inv_scale, ex.local_owners(), list, count, lambda, dv, norms,
+               changes);
     else
-      sweep<3>(sys, cones, b, inv_scale, ex.local_owners(), lambda, dv, norms);
+      sweep<3>(sys, cones, b, inv_scale, ex.local_owners(), list, count, lambda, dv, norms,
+               changes);
+    if (changes) focus_list(contact_changes, norms[0], focus_contacts);
+    res.visits += count;
     // Every process's updates on every body: the sum of the local changes, owners and ghosts.
     if (halo) {
       moved = dv - dv_start;
@@ -130,7 +168,7 @@ PgsResult pgs(const ContactSystem &sys, const Exchange &ex, const Cones &cones, 
       res.reason = StopReason::non_finite;
       return res;
     }
-    res.record(norms[1] > 0 ? std::sqrt(norms[0] / norms[1]) : 0.0);
+    res.record(norms[1] > 0 ? std::sqrt(norms[0] / norms[1]) : 0.0, full);
     res.reason = StopReason::max_iterations;
     // with a floor, a met estimate stops the sweeps at the floor: the changes of the sweeps
     // after it may fall to round-off, where the estimated rate means nothing
@@ -140,7 +178,7 @@ PgsResult pgs(const ContactSystem &sys, const Exchange &ex, const Cones &cones, 
     const bool done = control.accuracy > 0 ? res.met_estimate <= control.accuracy &&
                                                  (res.sweeps >= control.min_sweeps || norms[0] == 0)
                                            : !(norms[0] > control.tol * control.tol * norms[1]);
-    if (done) {
+    if (done && full) {
       res.reason = StopReason::converged;
       break;
     }

@@ -152,6 +152,9 @@ std::size_t read_solver_keyword(const Reader &in, std::size_t i, StepOptions &op
   else if (key == "min_sweeps")
     opt.min_sweeps =
         static_cast<int>(in.integer(i + 1, "'min_sweeps <non-negative integer>'", 0, 100000));
+  else if (key == "focus_sweeps")
+    opt.focus_sweeps =
+        static_cast<int>(in.integer(i + 1, "'focus_sweeps <non-negative integer>'", 0, 1000));
   else if (key == "sweep_cg") {
     if (!in.has(i + 1) || (in.at(i + 1) != "yes" && in.at(i + 1) != "no"))
       Reader::illegal("'sweep_cg yes|no'", in.has(i + 1) ? &in.at(i + 1) : nullptr);
@@ -276,7 +279,8 @@ Settings parse_settings(const std::vector<std::string> &args)
       Reader::illegal(
           "a keyword (form, solver, precond, weight, tol, linear_tol, pass_tol, maxiter, "
           "compliance, damping, mu, mu_roll, mu_twist, rows, active_set, sweeps, "
-          "sweep_tol, rescue_sweeps, min_sweeps, sweep_cg, sweep_blocks, recovery_speed, "
+          "sweep_tol, rescue_sweeps, min_sweeps, focus_sweeps, sweep_cg, sweep_blocks, "
+          "recovery_speed, "
           "restitution, bounce_speed, "
           "coefficients, wall, export)",
           &key);

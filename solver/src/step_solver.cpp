@@ -23,8 +23,8 @@ std::string describe(const StepOptions &opt)
          std::to_string(opt.stop.max_iter) + ", active_set " + std::to_string(opt.active_set_max) +
          ", sweeps " + std::to_string(opt.sweeps) + ", sweep_tol " + g(opt.sweep_tol) +
          ", rescue_sweeps " + std::to_string(opt.rescue_sweeps) + ", min_sweeps " +
-         std::to_string(opt.min_sweeps) + (opt.sweep_cg ? ", sweep_cg yes" : "") +
-         (opt.sweep_blocks ? ", sweep_blocks yes" : "");
+         std::to_string(opt.min_sweeps) + ", focus_sweeps " + std::to_string(opt.focus_sweeps) +
+         (opt.sweep_cg ? ", sweep_cg yes" : "") + (opt.sweep_blocks ? ", sweep_blocks yes" : "");
 }
 
 namespace {
@@ -277,13 +277,17 @@ void StepSolver::finish(Vector &lambda, StepResult &res) const
   const auto t_sweep = Clock::now();
   const std::vector<Vec6> &scale = row_scales_;
   res.sweeps = 0;
-  res.complementarity = complementarity(sys_, ex_, cones_, b_full_, lambda, scale);
-  res.error_estimate = res.complementarity;
   const bool accuracy = opt_.accuracy > 0;
+  // Under the accuracy rule the sweeps run whatever the residual, and measure it after.
+  if (!accuracy || opt_.sweeps <= 0) {
+    res.complementarity = complementarity(sys_, ex_, cones_, b_full_, lambda, scale);
+    res.error_estimate = res.complementarity;
+  }
   if (opt_.sweeps > 0 && (accuracy || res.complementarity > opt_.sweep_tol)) {
     PgsControl control{opt_.sweeps, opt_.sweep_tol};
     control.accuracy = opt_.accuracy;
     control.min_sweeps = opt_.min_sweeps;
+    control.focus_sweeps = opt_.focus_sweeps;
     control.nonlinear_cg = opt_.sweep_cg || opt_.solver == Method::nncg;
     control.fibre_blocks = opt_.sweep_blocks || opt_.solver == Method::fbgs;
     control.block_weight = opt_.precond.weight;
