@@ -2,6 +2,7 @@
 
 #include <array>
 #include <cmath>
+#include <limits>
 #include <memory>
 
 #include "fibre/contact_rows.hpp"
@@ -90,6 +91,7 @@ void sweep(const ContactSystem &sys, const Cones &cones, const Vector &b,
 // The contacts that a full sweep moved by at least kFocusShare of its mean change^2: those
 // left out moved by less than kFocusShare of the sweep's change^2 together.
 constexpr double kFocusShare = 1e-3;
+constexpr double kRoundOff = 64 * std::numeric_limits<double>::epsilon(); // a relative change
 void focus_list(const std::vector<double> &changes, double total, std::vector<int> &list)
 {
   list.clear();
@@ -175,8 +177,14 @@ PgsResult pgs(const ContactSystem &sys, const Exchange &ex, const Cones &cones, 
     if (control.accuracy > 0 && !(res.met_estimate <= control.accuracy) &&
         res.error_estimate() <= control.accuracy)
       res.met_estimate = res.error_estimate();
+    // A full sweep that moves lambda by round-off only has converged as far as doubles go: its
+    // changes may then repeat exactly (a rate of 1, an infinite estimate; a solved column under
+    // focused sweeps swept on into stagnation).
+    const bool still = full && (norms[0] == 0 || res.last_change <= kRoundOff);
+    if (still && control.accuracy > 0)
+      res.met_estimate = std::min(res.met_estimate, res.last_change);
     const bool done = control.accuracy > 0 ? res.met_estimate <= control.accuracy &&
-                                                 (res.sweeps >= control.min_sweeps || norms[0] == 0)
+                                                 (res.sweeps >= control.min_sweeps || still)
                                            : !(norms[0] > control.tol * control.tol * norms[1]);
     if (done && full) {
       res.reason = StopReason::converged;

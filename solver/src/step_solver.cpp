@@ -277,6 +277,7 @@ void StepSolver::finish(Vector &lambda, StepResult &res) const
   const auto t_sweep = Clock::now();
   const std::vector<Vec6> &scale = row_scales_;
   res.sweeps = 0;
+  res.sweep_equivalents = 0;
   const bool accuracy = opt_.accuracy > 0;
   // Under the accuracy rule the sweeps run whatever the residual, and measure it after.
   if (!accuracy || opt_.sweeps <= 0) {
@@ -296,6 +297,7 @@ void StepSolver::finish(Vector &lambda, StepResult &res) const
                                ? apgd(sys_, ex_, cones_, b_full_, scale, lambda, control)
                                : pgs(sys_, ex_, cones_, b_full_, scale, lambda, control);
       res.sweeps += pr.sweeps;
+      res.sweep_equivalents += nc_ > 0 ? double(pr.visits) / nc_ : 0.0;
       res.sweep_reason = pr.reason;
       res.error_estimate = pr.reported_estimate();
       res.complementarity = complementarity(sys_, ex_, cones_, b_full_, lambda, scale);
@@ -432,6 +434,7 @@ StepResult StepSolver::run(const Vector *warm)
     StepResult again = res;
     finish(start, again);
     res.sweeps += again.sweeps;
+    res.sweep_equivalents += again.sweep_equivalents;
     res.sweep_seconds += again.sweep_seconds;
     if (!(again.complementarity >= res.complementarity)) {
       lambda = std::move(start);

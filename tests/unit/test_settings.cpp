@@ -60,7 +60,7 @@ TEST(Settings, NoKeywordsKeepTheDefaults)
       describe(s),
       "form body, solver pgs, precond tree, weight z, tol 0.0001, linear_tol 0.0001, pass_tol "
       "0.001, maxiter 200, active_set 1, sweeps 2000, sweep_tol 0.001, rescue_sweeps 500, "
-      "min_sweeps 10, focus_sweeps 3, rows 6, damping 2, "
+      "min_sweeps 10, focus_sweeps 0, rows 6, damping 2, "
       "compliance auto "
       "(0.01 dt^2 / m_min), recovery_speed auto (0.01 r_min / dt), restitution 0, "
       "bounce_speed auto (2 dt |f| / m max, or 0.01 r_min / dt without forces), coefficients "

@@ -40,7 +40,7 @@ struct PgsControl {
   int focus_sweeps = 0;
   double accuracy = 0; // the error-estimate rule (0: off)
   // The error-estimate rule stops no sooner than this: a rule met before stops the sweeps
-  // here (and a sweep that changes nothing at once).
+  // here (and a full sweep that changes nothing, or only by round-off, at once).
   int min_sweeps = 0;
 };
 
