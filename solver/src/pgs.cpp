@@ -91,7 +91,6 @@ void sweep(const ContactSystem &sys, const Cones &cones, const Vector &b,
 // The contacts that a full sweep moved by at least kFocusShare of its mean change^2: those
 // left out moved by less than kFocusShare of the sweep's change^2 together.
 constexpr double kFocusShare = 1e-3;
-constexpr double kRoundOff = 64 * std::numeric_limits<double>::epsilon(); // a relative change
 void focus_list(const std::vector<double> &changes, double total, std::vector<int> &list)
 {
   list.clear();
@@ -180,7 +179,8 @@ PgsResult pgs(const ContactSystem &sys, const Exchange &ex, const Cones &cones, 
     // A full sweep that moves lambda by round-off only has converged as far as doubles go: its
     // changes may then repeat exactly (a rate of 1, an infinite estimate; a solved column under
     // focused sweeps swept on into stagnation).
-    const bool still = full && (norms[0] == 0 || res.last_change <= kRoundOff);
+    constexpr double kRoundOff = 64 * std::numeric_limits<double>::epsilon();
+    const bool still = full && res.last_change <= kRoundOff; // 0 too: a sweep that changes nothing
     if (still && control.accuracy > 0)
       res.met_estimate = std::min(res.met_estimate, res.last_change);
     const bool done = control.accuracy > 0 ? res.met_estimate <= control.accuracy &&

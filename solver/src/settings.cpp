@@ -280,9 +280,7 @@ Settings parse_settings(const std::vector<std::string> &args)
           "a keyword (form, solver, precond, weight, tol, linear_tol, pass_tol, maxiter, "
           "compliance, damping, mu, mu_roll, mu_twist, rows, active_set, sweeps, "
           "sweep_tol, rescue_sweeps, min_sweeps, focus_sweeps, sweep_cg, sweep_blocks, "
-          "recovery_speed, "
-          "restitution, bounce_speed, "
-          "coefficients, wall, export)",
+          "recovery_speed, restitution, bounce_speed, coefficients, wall, export)",
           &key);
     i += used;
   }

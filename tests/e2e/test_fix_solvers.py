@@ -89,7 +89,8 @@ def main():
 
         dx, dv = difference(1)  # step 10
         agree = dx < 1e-9 and dv < 1e-6
-        if label not in ("fbgs", "apgd", "tol", "focus", "default"):  # checked below, own tolerances
+        # checked below, with their own tolerances
+        if label not in ("fbgs", "apgd", "tol", "focus", "default"):
             ck.check(agree or (failed[1] > 0 and failed[2] > 0),
                      "%s: np 2 agrees with serial after 10 steps, or both runs report the steps "
                      "whose solve did not converge" % label,
