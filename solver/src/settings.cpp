@@ -117,7 +117,7 @@ std::size_t read_wall(const Reader &in, std::size_t i, WallSpec &w)
 
 // The solver keywords; returns the words read, 0 when `key` is not one of them.
 std::size_t read_solver_keyword(const Reader &in, std::size_t i, StepOptions &opt,
-                                bool &sweeps_typed)
+                                bool &sweeps_typed, bool &anderson_typed)
 {
   const std::string &key = in.at(i);
   if (key == "form")
@@ -155,7 +155,10 @@ std::size_t read_solver_keyword(const Reader &in, std::size_t i, StepOptions &op
   else if (key == "focus_sweeps")
     opt.focus_sweeps =
         static_cast<int>(in.integer(i + 1, "'focus_sweeps <non-negative integer>'", 0, 1000));
-  else if (key == "sweep_cg") {
+  else if (key == "anderson") {
+    opt.anderson = static_cast<int>(in.integer(i + 1, "'anderson <integer 0 to 50>'", 0, 50));
+    anderson_typed = true;
+  } else if (key == "sweep_cg") {
     if (!in.has(i + 1) || (in.at(i + 1) != "yes" && in.at(i + 1) != "no"))
       Reader::illegal("'sweep_cg yes|no'", in.has(i + 1) ? &in.at(i + 1) : nullptr);
     opt.sweep_cg = in.at(i + 1) == "yes";
@@ -258,10 +261,10 @@ Settings parse_settings(const std::vector<std::string> &args)
   Settings s;
   const Reader in(args);
   std::size_t i = 0;
-  bool sweeps_typed = false;
+  bool sweeps_typed = false, anderson_typed = false;
   while (i < args.size()) {
     const std::string &key = args[i];
-    std::size_t used = read_solver_keyword(in, i, s.step, sweeps_typed);
+    std::size_t used = read_solver_keyword(in, i, s.step, sweeps_typed, anderson_typed);
     if (!used) used = read_model_keyword(in, i, s);
     if (!used && key == "wall") {
       WallSpec w;
@@ -279,13 +282,21 @@ Settings parse_settings(const std::vector<std::string> &args)
       Reader::illegal(
           "a keyword (form, solver, precond, weight, tol, linear_tol, pass_tol, maxiter, "
           "compliance, damping, mu, mu_roll, mu_twist, rows, active_set, sweeps, "
-          "sweep_tol, rescue_sweeps, min_sweeps, focus_sweeps, sweep_cg, sweep_blocks, "
+          "sweep_tol, rescue_sweeps, min_sweeps, focus_sweeps, anderson, sweep_cg, sweep_blocks, "
           "recovery_speed, restitution, bounce_speed, coefficients, wall, export)",
           &key);
     i += used;
   }
   // a step accuracy needs room to reach it; a fast step (tol none) stops at its cap
   if (!sweeps_typed) s.step.sweeps = s.step.accuracy > 0 ? kAccuracySweeps : kFastSweeps;
+  StepOptions &o = s.step;
+  const bool plain =
+      !(o.solver == Method::nncg || o.solver == Method::apgd || o.solver == Method::fbgs ||
+        o.sweep_cg || o.sweep_blocks || o.focus_sweeps > 0);
+  if (!plain && !anderson_typed) o.anderson = 0; // the default accelerates plain sweeps only
+  if (!plain && o.anderson > 0)
+    throw SettingsError("anderson accelerates plain sweeps: not with solver nncg, apgd or fbgs, "
+                        "sweep_cg yes, sweep_blocks yes, or focus_sweeps");
   const FrictionParams &f = s.model.friction;
   if (s.model.rows == 3 && (f.mu_roll > 0.0 || f.mu_twist > 0.0))
     throw SettingsError("mu_roll and mu_twist need 'rows 6' (rows 3 has no rotational rows)");

@@ -24,7 +24,8 @@ std::string describe(const StepOptions &opt)
          ", sweeps " + std::to_string(opt.sweeps) + ", sweep_tol " + g(opt.sweep_tol) +
          ", rescue_sweeps " + std::to_string(opt.rescue_sweeps) + ", min_sweeps " +
          std::to_string(opt.min_sweeps) + ", focus_sweeps " + std::to_string(opt.focus_sweeps) +
-         (opt.sweep_cg ? ", sweep_cg yes" : "") + (opt.sweep_blocks ? ", sweep_blocks yes" : "");
+         ", anderson " + std::to_string(opt.anderson) + (opt.sweep_cg ? ", sweep_cg yes" : "") +
+         (opt.sweep_blocks ? ", sweep_blocks yes" : "");
 }
 
 namespace {
@@ -289,6 +290,7 @@ void StepSolver::finish(Vector &lambda, StepResult &res) const
     control.accuracy = opt_.accuracy;
     control.min_sweeps = opt_.min_sweeps;
     control.focus_sweeps = opt_.focus_sweeps;
+    control.anderson = opt_.anderson;
     control.nonlinear_cg = opt_.sweep_cg || opt_.solver == Method::nncg;
     control.fibre_blocks = opt_.sweep_blocks || opt_.solver == Method::fbgs;
     control.block_weight = opt_.precond.weight;

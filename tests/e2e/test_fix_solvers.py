@@ -59,6 +59,7 @@ SOLVERS = {
     "sweep_cg": "solver cg tol none sweep_cg yes sweeps 5000 sweep_tol 1e-10",
     "tol": "tol 1e-6 sweeps 20000",
     "focus": "tol 1e-6 sweeps 20000 focus_sweeps 3",
+    "anderson": "tol 1e-6 sweeps 20000 anderson 3",
     "default": "",
 }
 
@@ -90,7 +91,7 @@ def main():
         dx, dv = difference(1)  # step 10
         agree = dx < 1e-9 and dv < 1e-6
         # checked below, with their own tolerances
-        if label not in ("fbgs", "apgd", "tol", "focus", "default"):
+        if label not in ("fbgs", "apgd", "tol", "focus", "anderson", "default"):
             ck.check(agree or (failed[1] > 0 and failed[2] > 0),
                      "%s: np 2 agrees with serial after 10 steps, or both runs report the steps "
                      "whose solve did not converge" % label,
@@ -110,7 +111,7 @@ def main():
                      "apgd: np 2 within 1e-7 m and 1e-5 m/s; non-converged steps reported alike",
                      "%.2g m, %.2g m/s; non-converged steps %g and %g" % (dx, dv, failed[1],
                                                                          failed[2]))
-        if label in ("tol", "focus"):
+        if label in ("tol", "focus", "anderson"):
             # tol is the step's accuracy: serial converges on every step, every converged
             # step's error estimate is within tol, and np 2 agrees to it (velocities of about
             # 1 m/s; a few np 2 steps stop at the cap, block Jacobi across the processes)

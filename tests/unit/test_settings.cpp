@@ -49,6 +49,7 @@ TEST(Settings, NoKeywordsKeepTheDefaults)
   EXPECT_EQ(d.sweeps, kAccuracySweeps);
   EXPECT_DOUBLE_EQ(d.sweep_tol, 1e-3);
   EXPECT_DOUBLE_EQ(d.accuracy, 1e-4); // the step's accuracy
+  EXPECT_EQ(d.anderson, 3);
   EXPECT_DOUBLE_EQ(s.model.friction.mu, 0.5);
   EXPECT_EQ(s.model.rows, 6);
   EXPECT_DOUBLE_EQ(s.model.damping, 2.0);
@@ -60,7 +61,7 @@ TEST(Settings, NoKeywordsKeepTheDefaults)
       describe(s),
       "form body, solver pgs, precond tree, weight z, tol 0.0001, linear_tol 0.0001, pass_tol "
       "0.001, maxiter 200, active_set 1, sweeps 2000, sweep_tol 0.001, rescue_sweeps 500, "
-      "min_sweeps 10, focus_sweeps 0, rows 6, damping 2, "
+      "min_sweeps 10, focus_sweeps 0, anderson 3, rows 6, damping 2, "
       "compliance auto "
       "(0.01 dt^2 / m_min), recovery_speed auto (0.01 r_min / dt), restitution 0, "
       "bounce_speed auto (2 dt |f| / m max, or 0.01 r_min / dt without forces), coefficients "
@@ -127,6 +128,14 @@ TEST(Settings, EveryKeywordSetsWhatItNames)
   EXPECT_DOUBLE_EQ(automatic.max_recovery(0.01, 0.5), 0.01 * 0.5 / 0.01);
   EXPECT_DOUBLE_EQ(parse_settings(words("recovery_speed 0.3")).model.max_recovery(0.01, 0.5), 0.3);
   EXPECT_EQ(parse_settings(words("solver mumps")).step.solver, Method::direct);
+  EXPECT_EQ(parse_settings(words("anderson 0")).step.anderson, 0);
+  EXPECT_EQ(parse_settings(words("anderson 5")).step.anderson, 5);
+  // the default accelerates plain sweeps only
+  EXPECT_EQ(parse_settings(words("solver nncg")).step.anderson, 0);
+  EXPECT_EQ(parse_settings(words("focus_sweeps 3")).step.anderson, 0);
+  EXPECT_EQ(parse_settings(words("solver cg")).step.anderson, 3);
+  EXPECT_NE(describe(parse_settings(words("anderson 3")).step).find("anderson 3"),
+            std::string::npos);
 }
 
 // Strict numbers: the whole word, finite; an underflow to a subnormal is a number, an overflow
@@ -195,6 +204,10 @@ TEST(Settings, BadInputNamesTheKeywordAndItsForm)
             "expected 'wall xplane|yplane|zplane <lo|NULL> <hi|NULL>', 'wall region <region-ID>' "
             "or 'wall mesh <fix-ID>', got 'cylinder'");
   EXPECT_EQ(error_of("export 10"), "expected 'export <N> <file-prefix>' (N a positive integer)");
+  EXPECT_EQ(error_of("anderson 51"), "expected 'anderson <integer 0 to 50>', got '51'");
+  EXPECT_EQ(error_of("solver nncg anderson 3"),
+            "anderson accelerates plain sweeps: not with solver nncg, apgd or fbgs, sweep_cg yes, "
+            "sweep_blocks yes, or focus_sweeps");
   EXPECT_EQ(error_of("rows 3 mu_roll 0.1"),
             "mu_roll and mu_twist need 'rows 6' (rows 3 has no rotational rows)");
   EXPECT_NE(error_of("speed 3").find("expected a keyword (form, solver"), std::string::npos);

@@ -38,6 +38,12 @@ struct PgsControl {
   // nonlinear CG or fibre blocks. Most of a step's change is in a few contacts (the new
   // impacts, a sliding region), and the sweeps between full ones spend nothing on the rest.
   int focus_sweeps = 0;
+  // Anderson acceleration (Walker and Ni 2011, type II) over this many sweeps (0: off): a sweep
+  // is a fixed-point map g = G(x), and the next sweep starts from g less the combination of the
+  // last differences of g whose differences of f = G(x) - x best cancel f (least squares). On a
+  // settled stiff pile the sweeps' error lies in a few slow modes of the whole pile, which the
+  // combination removes together. Not with focused sweeps, nonlinear CG or fibre blocks.
+  int anderson = 0;
   double accuracy = 0; // the error-estimate rule (0: off)
   // The error-estimate rule stops no sooner than this: a rule met before stops the sweeps
   // here (and a full sweep that changes nothing, or only by round-off, at once).
@@ -45,6 +51,7 @@ struct PgsControl {
 };
 
 inline constexpr int kRateWindow = 5;
+inline constexpr double kAndersonSafety = 2.0;
 
 struct PgsResult {
   StopReason reason = StopReason::max_iterations;
@@ -59,6 +66,10 @@ struct PgsResult {
   // about last_change * contraction / (1 - contraction): infinite while the changes do not
   // fall.
   double contraction = 1;
+  // Anderson acceleration: the estimate of I - J's smallest singular value (J the sweep's
+  // Jacobian) from the history, infinite without one; -1 without acceleration. The estimate
+  // is then kAndersonSafety * last_change / singular_value.
+  double singular_value = -1;
   std::vector<double> changes;  // per sweep (iteration)
   std::vector<int> full_sweeps; // the full sweeps' indices in `changes`
   // One more sweep's change: changes follows, and for a full sweep (every plain one)
