@@ -127,7 +127,9 @@ class Anderson {
   double mix(Vector &steps, Vector &lambda, Vector &dv)
   {
     const Eigen::Index n = lambda.size();
-    if (f_prev_.size() != n) { // the first sweep, or after a restart
+    if (!started_) { // the first sweep, or after a restart (every process alike: a process
+                     // without contacts takes part in the sums below)
+      started_ = true;
       f_prev_.swap(steps);
       steps.resize(n);
       g_prev_ = lambda;
@@ -209,7 +211,7 @@ class Anderson {
   {
     count_ = 0;
     newest_ = -1;
-    f_prev_.resize(0);
+    started_ = false;
   }
 
  private:
@@ -239,7 +241,7 @@ class Anderson {
   std::vector<const double *> ptr_;
   int count_ = 0, newest_ = -1;
   double sigma_ = INFINITY; // the smallest over the whole solve: restarts keep it
-  bool combined_ = false;
+  bool combined_ = false, started_ = false;
   std::vector<Vector> dF_, dG_, dDV_;
   std::vector<double> dX2_;
   Vector f_prev_, g_prev_, dv_prev_;
