@@ -163,7 +163,7 @@ class Anderson {
     f_prev_.swap(steps);
     dDV_[j] = dv - dv_prev_;
     dv_prev_ = dv;
-    columns(dF_, dots.data()); // the Gram matrix's new column: one pass over every dF_i
+    columns(dF_); // the Gram matrix's new column: one pass over every dF_i
     {
       const double *df = dF_[j].data();
       for (Eigen::Index e0 = 0; e0 < n; e0 += kBlock) { // blocks of dF_j stay in cache
@@ -215,15 +215,16 @@ class Anderson {
   }
 
  private:
-  void columns(const std::vector<Vector> &v, double *)
-  { // the columns' data in ptr_
+  // the columns' data in ptr_
+  void columns(const std::vector<Vector> &v)
+  {
     ptr_.resize(count_);
     for (int i = 0; i < count_; ++i) ptr_[i] = v[i].data();
   }
   // y -= sum_i gamma_i v_i in one pass
   void combine(const std::vector<Vector> &v, const Vector &gamma, Vector &y)
   {
-    columns(v, nullptr);
+    columns(v);
     double *out = y.data();
     const Eigen::Index n = y.size();
     for (Eigen::Index e0 = 0; e0 < n; e0 += kBlock) { // a block of y stays in cache
