@@ -144,40 +144,29 @@ class Anderson {
       dF_.resize(count_), dG_.resize(count_), dDV_.resize(count_), dX2_.resize(count_);
     }
     dF_[j].resize(n), dG_[j].resize(n);
-    // the new column, dF_j . f_prev and |dX_j|^2 (dX = dG - dF) in one pass
+    // One pass in blocks that stay in cache: the new columns dF_j, dG_j, then dF_j . f_prev,
+    // |dX_j|^2 (dX = dG - dF) and the Gram matrix's new column dF_i . dF_j. The dot products
+    // and the copies are Eigen's (vectorized, several accumulators): a plain loop's single
+    // running sum is a chain of dependent adds, and its possible aliasing kept it scalar.
     std::vector<double> &dots = dots_;
     dots.assign(count_ + 2, 0.0);
-    {
-      double *df = dF_[j].data(), *dg = dG_[j].data(), *fp = f_prev_.data(), *gp = g_prev_.data();
-      const double *st = steps.data(), *l = lambda.data();
-      double dot_fp = 0, dx2 = 0;
-      for (Eigen::Index e = 0; e < n; ++e) {
-        const double d = st[e] - fp[e], g = l[e] - gp[e];
-        df[e] = d;
-        dg[e] = g;
-        dot_fp += d * fp[e];
-        dx2 += (g - d) * (g - d);
-        gp[e] = l[e];
-      }
-      dots[count_] = dot_fp;
-      dots[count_ + 1] = dx2;
+    columns(dF_);
+    double *df = dF_[j].data(), *dg = dG_[j].data(), *fp = f_prev_.data(), *gp = g_prev_.data();
+    const double *st = steps.data(), *l = lambda.data();
+    for (Eigen::Index e0 = 0; e0 < n; e0 += kBlock) {
+      const Eigen::Index len = std::min(n - e0, kBlock);
+      const ConstMap l_block(l + e0, len);
+      Map(df + e0, len) = ConstMap(st + e0, len) - ConstMap(fp + e0, len);
+      Map(dg + e0, len) = l_block - ConstMap(gp + e0, len);
+      Map(gp + e0, len) = l_block;
+      const ConstMap df_block(df + e0, len), dg_block(dg + e0, len);
+      dots[count_] += df_block.dot(ConstMap(fp + e0, len));
+      dots[count_ + 1] += (dg_block - df_block).squaredNorm();
+      for (int i = 0; i < count_; ++i) dots[i] += ConstMap(ptr_[i] + e0, len).dot(df_block);
     }
     f_prev_.swap(steps);
     dDV_[j] = dv - dv_prev_;
     dv_prev_ = dv;
-    columns(dF_); // the Gram matrix's new column: one pass over every dF_i
-    {
-      const double *df = dF_[j].data();
-      for (Eigen::Index e0 = 0; e0 < n; e0 += kBlock) { // blocks of dF_j stay in cache
-        const Eigen::Index e1 = std::min(n, e0 + kBlock);
-        for (int i = 0; i < count_; ++i) {
-          const double *p = ptr_[i];
-          double dot = 0;
-          for (Eigen::Index e = e0; e < e1; ++e) dot += p[e] * df[e];
-          dots[i] += dot;
-        }
-      }
-    }
     ex_.sum(dots.data(), count_ + 2);
     // rhs_i = dF_i . f with f = f_prev + dF_j
     for (int i = 0; i < count_; ++i) {
@@ -237,6 +226,8 @@ class Anderson {
     }
   }
 
+  using Map = Eigen::Map<Vector>;
+  using ConstMap = Eigen::Map<const Vector>;
   static constexpr Eigen::Index kBlock = 512;
   int memory_;
   const Exchange &ex_;
