@@ -163,23 +163,30 @@ void LammpsDetection::pair_contacts(const std::vector<fibre::Body> &bodies, doub
 
       // the atom with the smaller tag stores the warm start if it is owned here
       const int low = tag[i] < tag[j] ? i : j, high = low == i ? j : i;
-      fibre::DetectedContact fc;
-      fc.store = low < nlocal ? low : high;
+      const int store = low < nlocal ? low : high;
+      const auto keep = [&](fibre::DetectedContact &fc) {
+        fc.store = store;
+        fc.key = tag[store] == fc.tag_a ? fc.partner : static_cast<double>(fc.tag_a);
+      };
       if (bi >= 0 && bj >= 0) {
         const int a = tag[i] < tag[j] ? bi : bj, b = a == bi ? bj : bi;
         fibre::Vec3 normal;
         double gap = 0.0;
         fibre::sphere_sphere_gap(bodies[a], bodies[b], normal, gap);
         if (!accept(bodies[a], &bodies[b], normal, gap, h, damping, kick(a) + kick(b))) continue;
+        // built only here: most listed pairs are no contact, and a Contact is hundreds of bytes
+        fibre::DetectedContact &fc = found.emplace_back();
         fc.contact = fibre::sphere_sphere_contact(bodies, a, b);
         fc.tag_a = tag[low];
         fc.partner = static_cast<double>(tag[high]);
+        keep(fc);
       } else {
         // one atom is outside the group: a fixed spherical obstacle
         const int g = bi >= 0 ? i : j, o = g == i ? j : i;
         const double sign = g == i ? 1.0 : -1.0, dist = std::sqrt(rsq);
         fibre::Vec3 n(sign * dx, sign * dy, sign * dz);
         n = dist > 0.0 ? fibre::Vec3(n / dist) : fibre::Vec3::UnitZ();
+        fibre::DetectedContact fc;
         fc.contact = fibre::sphere_wall_contact(bodies, atom_body_[g], n, dist - radius[o]);
         fc.contact.wall_type = atom->type[o];
         fc.contact.wall_radius = radius[o];
@@ -193,9 +200,9 @@ void LammpsDetection::pair_contacts(const std::vector<fibre::Body> &bodies, doub
           continue;
         fc.tag_a = tag[g];
         fc.partner = static_cast<double>(tag[o]);
+        keep(fc);
+        found.push_back(std::move(fc));
       }
-      fc.key = tag[fc.store] == fc.tag_a ? fc.partner : static_cast<double>(fc.tag_a);
-      found.push_back(fc);
     }
   }
 }
