@@ -2,18 +2,20 @@
 twin of the same material.
 
 Runs examples/janssen/in.janssen (fix fibre_contact, compliance material) and its native twin
-in.janssen.native with seed 4767: 2,560 spheres filled in 4 batches into an 8 x 8 bin with
-friction on the walls, settled for 12 s, then 10 snapshots over 1 s. Checks:
+in.janssen.native with seeds 4767, 1031 and 2203: 2,560 spheres filled in 4 batches into an
+8 x 8 bin with friction on the walls, settled for 12 s, then 10 snapshots over 1 s. Checks:
 - the Janssen effect in both twins: the side walls carry part of the weight by friction, the
   floor less than 80% of it (measured 0.67 and 0.68);
 - the fix's wall loads (f_fc[w][3]) balance the weight: the side walls' and the floor's z loads,
   averaged over the snapshots' run, within 3% of the weight (a static pack);
 - against the native twin: Janssen's saturation pressure p_sat (the fit of
   p_sat (1 - exp(-(h - z) / lambda)) to the side-wall pressure by height, examples/janssen/
-  janssen.py), the deep pressure and the floor's share, each the mean of seeds 4767 and 1031,
-  within 10% (over three seeds the means agree to 2.8%, 1.0% and 4.2%: examples/README.md).
-  One seed's p_sat scatters by up to 13% (fibre: 33.0 to 41.9 over three seeds), too much for
-  a one-seed check.
+  janssen.py), the deep pressure and the floor's share, each the mean of the three seeds,
+  within 10%. Measured (examples/README.md): the means agreed to 2.8%, 1.0% and 4.2%
+  (session 13) and to 6.9%, 1.6% and 3.3% (session 21, a build that differs only in
+  round-off). One seed's p_sat scatters by about 9% (standard deviation; fibre 32.8 to 41.9
+  over nine runs), so two seeds' mean moved from 1.075 to 1.118 of native's with round-off
+  alone: three seeds, the target's own measurement, are compared.
 """
 
 import argparse
@@ -22,7 +24,7 @@ import sys
 
 import fibre_e2e as e2e
 
-SEEDS = (4767, 1031)
+SEEDS = (4767, 1031, 2203)
 
 
 def main():
