@@ -37,6 +37,7 @@
 #include "host.h"
 #include "lammps_exchange.h"
 #include "modify.h"
+#include "neighbor.h"
 #include "pair.h"
 #include "update.h"
 
@@ -346,6 +347,25 @@ void FixFibreContact::warn_double_integration()
   }
 }
 
+// The contacts come from the pair style's neighbor list. At this fix's steps an atom moves
+// much further per step than under soft contacts, and a list kept for `delay` steps (10 by
+// default in Debian's LAMMPS) or built only every N steps misses pairs that close between its
+// builds: two spheres closing at 0.2 diameters a step passed through each other
+// (tests/e2e/test_fix_collision.py). So the list is checked every step.
+void FixFibreContact::check_neighbor_updates()
+{
+  if (neighbor->every == 1 && neighbor->delay == 0 && neighbor->dist_check) return;
+  if (comm->me == 0)
+    warn(error, FLERR,
+         "Fix fibre_contact: neigh_modify every " + std::to_string(neighbor->every) + " delay " +
+             std::to_string(neighbor->delay) + " check " + (neighbor->dist_check ? "yes" : "no") +
+             " can miss contacts between neighbor list builds (spheres then pass through each "
+             "other); the fix sets every 1 delay 0 check yes");
+  neighbor->every = 1;
+  neighbor->delay = 0;
+  neighbor->dist_check = 1;
+}
+
 void FixFibreContact::init()
 {
   if (starts_with(update->integrate_style, "respa"))
@@ -356,6 +376,7 @@ void FixFibreContact::init()
   warn_double_integration();
   warn_pair_computes();
   warn_short_damping();
+  check_neighbor_updates();
   read_coefficients();
   if (comm->me == 0) logmesg(lmp, "fix fibre_contact: " + fibre::describe(settings_) + "\n");
 }

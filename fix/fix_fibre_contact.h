@@ -62,6 +62,7 @@ class FixFibreContact : public Fix {
   void warn_double_integration();
   void warn_pair_computes();
   void warn_short_damping();
+  void check_neighbor_updates();
   void read_coefficients();
   void check_finite(const char *what, double **array, int nvalues) const;
   void smallest_body(const std::vector<fibre::Body> &bodies);

@@ -11,6 +11,10 @@
   conserved, no energy gain.
 - A cluster of 27 touching spheres with random velocities, without and with friction (also
   with MUMPS): momentum conserved, no energy gain.
+- Two spheres that close 0.2 a step, with the neighbor list kept for 10 steps (neigh_modify
+  delay 10, which a converted deck may carry): the fix checks the list every step instead and
+  says so, so they collide and stop touching (SPOOK is inelastic) where the list's delay let
+  them pass through each other (they swapped sides); one and two processes.
 - A sphere dropped onto a floor: total energy (kinetic + rotational + potential, the
   potential taken at the midpoint z + dt vz / 2 of the next drift, which the scheme conserves
   exactly in free fall) never grows, the overlap stays below v_impact dt and decays, the
@@ -203,6 +207,35 @@ def drop(args, ck, opts, tag):
              "z = %.8g, overlap %.3g" % (rows[-1]["v_z"], rows[-1]["f_fc[7]"]))
 
 
+def fast_pass(args, ck, np):
+    box = "-20 20 -20 20 -20 20"
+    lines = e2e.sphere_box(box, processors="2 1 1" if np > 1 else None) + [
+        "create_atoms 1 single -3 0 0 units box",
+        "create_atoms 1 single 3 0 0 units box",
+        "set group all diameter 1.0 density 1.0",
+        "group a id 1",
+        "group b id 2",
+        "velocity a set 10 0 0",
+        "velocity b set -10 0 0",
+        "variable x1 equal x[1]",
+        "variable x2 equal x[2]",
+    ] + pair_and_fix("") + ["neigh_modify delay 10", "thermo_style custom step v_x1 v_x2",
+                            "thermo 10", "run 60"]
+    tag = "fast_pass_np%d" % np
+    run = e2e.run_lmp(args, "\n".join(lines) + "\n", "collision_" + tag, np=np)
+    if not ck.ran(run, "%s: run completes" % tag):
+        return
+    warned = "neigh_modify every 1 delay 10 check yes can miss contacts" in run.output
+    ck.check(warned, "%s: the fix says it checks the neighbor list every step" % tag,
+             "warning %s" % ("given" if warned else "missing"))
+    last = run.thermo[-1][-1]
+    gap = last["v_x2"] - last["v_x1"] - 1.0
+    ck.check(abs(gap) < 1e-6, "%s: the spheres collide and stop touching, not pass" % tag,
+             "x1 %.6g, x2 %.6g (passed through: x1 > x2)" % (last["v_x1"], last["v_x2"]))
+    ck.check("Dangerous builds = 0" in run.output, "%s: no dangerous neighbor list builds" % tag,
+             "".join(line for line in run.output.splitlines() if "Dangerous" in line))
+
+
 def main():
     args = e2e.parse_args()
     ck = e2e.Checks("collisions")
@@ -215,6 +248,8 @@ def main():
     for tag, opts in [("frictionless", "mu 0"), ("friction", "mu 0.5"),
                       ("friction_direct", "mu 0.5 solver direct")]:
         cluster(args, ck, opts, tag)
+    for np in (1, 2):
+        fast_pass(args, ck, np)
     ck.close()
 
 
