@@ -441,6 +441,28 @@ void FixFibreContact::smallest_body(const std::vector<fibre::Body> &bodies)
   if (std::isfinite(m[1])) r_min_ = m[1];
 }
 
+// Once per step size, where the pair style is a material and the group has atoms: the step
+// against the law's shortest collision time, the number that says whether the step resolves
+// the collisions of a flow (doc page, "Time step and stiff materials").
+void FixFibreContact::log_step_against_collision()
+{
+  const fibre::ContactModel &model = settings_.model;
+  if (dtv_ == step_logged_ || !(m_min_ > 0) || !(r_min_ > 0) || !model.compliance.material) return;
+  step_logged_ = dtv_;
+  const fibre::PairCollisionTime shortest =
+      fibre::shortest_collision_time(model.materials, r_min_, m_min_, 1.0);
+  if (!(shortest.t_c > 0) || comm->me != 0) return;
+  const auto g = [](double x) { return fibre::format_g(x); };
+  logmesg(lmp, "fix fibre_contact: the step " + g(dtv_) + " is " + g(dtv_ / shortest.t_c) +
+                   " collision times of the pair style's law (t_c " + g(shortest.t_c) +
+                   ": two spheres of the smallest radius " + g(r_min_) + " and mass " + g(m_min_) +
+                   " meeting at 1 velocity unit, type pair " + std::to_string(shortest.i) + " " +
+                   std::to_string(shortest.j) +
+                   "). Above about 0.3 t_c a collisional flow's contacts act as enduring ones, "
+                   "and its heaps and flows come out steeper and less mobile than the law's "
+                   "(doc page, \"Time step and stiff materials\")\n");
+}
+
 // Approach speeds at or below this are plastic (ContactModel::bounce_speed); the automatic rule
 // reads the external forces of every process.
 double FixFibreContact::bounce_speed(const std::vector<fibre::Body> &bodies) const
@@ -553,6 +575,7 @@ void FixFibreContact::final_integrate()
   std::vector<fibre::DetectedContact> found =
       detection_->contacts(bodies, dtv_, model.damping, model.may_bounce());
   smallest_body(bodies);
+  log_step_against_collision();
   fibre::SpookParams params{dtv_, model.damping, model.max_recovery(dtv_, r_min_)};
   params.bounce_speed = bounce_speed(bodies);
   if (first_step_) warn_deep_overlaps(bodies, found, params.max_recovery);

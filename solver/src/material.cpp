@@ -192,6 +192,17 @@ double collision_time(const PairCoefficients &p, double r_eff, double m_eff, dou
   return 2.0 * half_period * d_max / v;
 }
 
+PairCollisionTime shortest_collision_time(const MaterialTable &table, double r, double m, double v)
+{
+  PairCollisionTime shortest;
+  for (int i = 1; i <= table.ntypes(); ++i)
+    for (int j = i; j <= table.ntypes(); ++j) {
+      const double t_c = collision_time(table.at(i, j), 0.5 * r, 0.5 * m, v);
+      if (t_c > 0 && (shortest.t_c == 0 || t_c < shortest.t_c)) shortest = {t_c, i, j};
+    }
+  return shortest;
+}
+
 double liggghts_hertz_damping(double e)
 {
   const double ln = std::log(e), pi = std::acos(-1.0);

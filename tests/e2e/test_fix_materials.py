@@ -177,6 +177,30 @@ def hertz_column(args, ck, np, fix_extra):
                  "material)" in run.output, "%s: the log names the default compliance" % tag)
 
 
+def collision_log(ck, run, tag):
+    """The log states the step against the law's collision time: two spheres of the smallest
+    radius (0.5) and mass meeting at 1 velocity unit, Hertz with k_n = 4/3 E / (2 (1 - nu^2)),
+    t_c = 2 * 0.4 B(0.4, 0.5) d_max / v, d_max = (5 m_eff v^2 / (4 k_n sqrt(r_eff)))^(2/5)."""
+    found = re.search(r"the step (\S+) is (\S+) collision times of the pair style's law "
+                      r"\(t_c (\S+): two spheres of the smallest radius (\S+) and mass (\S+) "
+                      r"meeting at 1 velocity unit, type pair (\d+) (\d+)\)", run.output)
+    if not ck.check(found is not None, "%s: the log states the step against the collision time"
+                    % tag):
+        return
+    E, nu, r, v = 1e6, 0.3, 0.5, 1.0
+    m = 4.0 / 3.0 * math.pi * r ** 3
+    k_n = 4.0 / 3.0 * E / (2 * (1 - nu * nu))
+    d_max = (5 * (m / 2) * v * v / (4 * k_n * (r / 2) ** 0.5)) ** 0.4
+    half = 0.4 * math.gamma(0.4) * math.gamma(0.5) / math.gamma(0.9)
+    t_c = 2 * half * d_max / v
+    step, ratio, logged = (float(found.group(k)) for k in (1, 2, 3))
+    ck.check(abs(logged - t_c) < 1e-4 * t_c and abs(ratio - DT / t_c) < 1e-4 * ratio and
+             step == DT and found.group(6, 7) == ("1", "1"),
+             "%s: the logged t_c is Hertz's for the pair's E and nu" % tag,
+             "t_c %s against %.6g, ratio %s against %.6g" % (found.group(3), t_c, found.group(2),
+                                                             DT / t_c))
+
+
 def main():
     args = e2e.parse_args()
     ck = e2e.Checks("coefficients per type pair")
@@ -185,7 +209,10 @@ def main():
         ck.check("1 1: mu 0.2, mu_roll 1, twisting none, restitution 0.439" in run.output and
                  "2 2: mu 0.8, mu_roll 1, twisting none, restitution 0.928" in run.output,
                  "incline_types: the log lists the coefficients read per type pair")
-    incline(args, ck, "incline_types_np2", GRANULAR, "", [(True, 0.2), (False, 0.8)], np=2)
+        collision_log(ck, run, "incline_types")
+    run = incline(args, ck, "incline_types_np2", GRANULAR, "", [(True, 0.2), (False, 0.8)], np=2)
+    if run.rc == 0:
+        collision_log(ck, run, "incline_types_np2")
     incline(args, ck, "incline_typed_mu", GRANULAR, "mu 0.9", [(False, 0.9), (False, 0.9)])
     rebounds = native_rebounds(args, ck)
     drop(args, ck, rebounds, 1)
@@ -199,6 +226,8 @@ def main():
                  "incline_gran_hooke: the log says xmu is used and the springs are not")
         ck.check(", compliance auto (0.01 dt^2 / m_min)," in run.output,
                  "incline_gran_hooke: the default compliance of gran/* is auto")
+        ck.check("collision times" not in run.output,
+                 "incline_gran_hooke: no collision time where the pair style is no material")
     incline(args, ck, "incline_coefficients_fix", GRANULAR, "coefficients fix mu_roll 1.0",
             [(False, 0.5), (False, 0.5)])
     hertz_column(args, ck, 1, "compliance material")

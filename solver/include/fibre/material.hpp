@@ -126,6 +126,16 @@ bool material_compliance(const PairCoefficients &p, double r_eff, double overlap
 // d_max = (5 m_eff v^2 / (4 K))^2/5. 0 where p has no normal law.
 double collision_time(const PairCoefficients &p, double r_eff, double m_eff, double v);
 
+// The shortest collision_time over the table's type pairs for two equal spheres of radius r
+// and mass m meeting at speed v (r_eff r / 2, m_eff m / 2), and its pair i <= j; t_c 0 where
+// no pair has a normal law. The step's ratio to it says whether the step resolves collisions
+// (doc page, "Time step and stiff materials").
+struct PairCollisionTime {
+  double t_c = 0.0;
+  int i = 0, j = 0;
+};
+PairCollisionTime shortest_collision_time(const MaterialTable &table, double r, double m, double v);
+
 // The normal law's dashpot gamma_n (force per unit approach speed) of a contact of reduced mass
 // m_eff, contact radius a and secant stiffness k (the normal row's 1 / eps), as LAMMPS damps
 // it: tsuji alpha sqrt(m_eff k), velocity c, mass_velocity c m_eff, viscoelastic c m_eff a.
