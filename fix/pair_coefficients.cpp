@@ -139,9 +139,11 @@ void read_granular(const std::string &bytes, int ntypes, PairReading &out)
   out.notes.push_back("the stiffnesses of pair_coeff (normal, tangential, rolling and twisting "
                       "sds) set the rows' compliance ('compliance material', the default here; "
                       "'compliance auto' makes the rows rigid), and the normal, rolling and "
-                      "twisting dampers their rows' damping, at least SPOOK's (the tangential "
-                      "rows take the normal one's or its critical damping, whichever is "
-                      "longer; bounces take e); the tangential damping coefficient is not used");
+                      "twisting dampers their rows' damping, at least SPOOK's (with "
+                      "'normal_relaxation law' the normal row is the law's spring and dashpot "
+                      "by implicit Euler; the tangential rows take the normal law's or its "
+                      "critical damping, whichever is longer; bounces take e); the tangential "
+                      "damping coefficient is not used");
   if (cohesion) out.notes.push_back("the cohesion of dmt and jkr is not modelled");
   out.table = std::move(table);
   out.material = true;

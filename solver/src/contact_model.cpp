@@ -1,6 +1,7 @@
 #include "fibre/contact_model.hpp"
 
 #include <algorithm>
+#include <cmath>
 
 namespace fibre {
 
@@ -63,17 +64,19 @@ void apply_pair(const ContactModel &model, const PairCoefficients &pc, const Spo
   material_compliance(pc, reff, overlap, force, rigid, c.compliance, c.elastic);
   for (int r = rows; r < kMaxRows; ++r) c.elastic[r] = false;
   // A loaded contact's normal row is a Kelvin-Voigt element with the law's own dashpot (damping
-  // time gamma_n / k), at least SPOOK's d, below which a contact stiffer than the step rings. A
+  // time gamma_n / k), at least SPOOK's d, below which a contact stiffer than the step rings
+  // (normal_relaxation spook, the default; law: see the end of this function). A
   // law without a dashpot is damped critically, tau = 2 sqrt(m_eff eps). Its springs keep at
   // least that critical damping (below). Bounces come from e (doc/design.md, session 17).
   const double ma = bodies[c.a].mass;
   const double m_eff = c.is_wall() ? ma : ma * bodies[c.b].mass / (ma + bodies[c.b].mass);
-  double critical = 0.0; // the normal row's, in steps
+  double critical = 0.0;   // the normal row's, in steps
+  double tau_n = INFINITY; // the normal row's damping time (seconds): the law's dashpot
   if (c.elastic[0]) {
     const double eps = c.compliance[0];
     const double gamma_n = normal_damper(pc, m_eff, std::sqrt(reff * overlap), 1.0 / eps);
     critical = 2.0 * std::sqrt(m_eff * eps) / h;
-    const double tau_n = gamma_n >= 0 ? gamma_n * eps : critical * h;
+    tau_n = gamma_n >= 0 ? gamma_n * eps : critical * h;
     if (tau_n / h > model.damping) c.damping = tau_n / h;
   }
   // The springs take at least the contact's damping and the normal row's critical damping:
@@ -97,6 +100,20 @@ void apply_pair(const ContactModel &model, const PairCoefficients &pc, const Spo
     const double approach = -(bodies[c.a].v - vb).dot(c.normal);
     shorten_to_collision(pc, params, reff, m_eff, approach, floor, rows, c);
   }
+  // normal_relaxation law: where SPOOK would floor the law's dashpot at `damping` steps (a
+  // stiff flow's enduring contacts then relaxed over 2 h, many times the law's time:
+  // examples/README.md, "The constraints' relaxation time at a large step"), the normal row is
+  // the law's spring and dashpot by implicit Euler, which does not ring. Where the dashpot is
+  // longer SPOOK resolves the law's swing (ContactSolver.LoadedHertzContactSwingsAsTheDampedLaw)
+  // and implicit Euler would damp it. The other rows keep the contact's SPOOK damping.
+  if (model.normal_relaxation == NormalRelaxation::law && c.elastic[0] &&
+      tau_n < model.damping * h) {
+    const double kept = params.damping_of(c);
+    for (int r = 1; r < rows; ++r)
+      if (c.spring_damping[r] < 0) c.spring_damping[r] = kept;
+    c.damping = 0.75 + tau_n / h;
+    c.implicit_normal = true;
+  }
 }
 
 } // namespace
@@ -118,6 +135,7 @@ void apply_contact_model(const ContactModel &model, const SpookParams &params, d
     c.friction = model.friction;
     c.restitution = model.restitution;
     c.elastic.fill(false);
+    c.implicit_normal = false;
     c.damping = -1.0;
     c.spring_damping.fill(-1.0);
     c.damper_time.fill(0.0);

@@ -231,6 +231,10 @@ std::size_t read_model_keyword(const Reader &in, std::size_t i, Settings &s)
     s.model.coefficients = in.name<CoefficientSource>(i + 1, key);
     return 2;
   }
+  if (key == "normal_relaxation") {
+    s.model.normal_relaxation = in.name<NormalRelaxation>(i + 1, key);
+    return 2;
+  }
   if (key == "bounce_speed") {
     const std::string e = "'bounce_speed auto|<non-negative speed>'";
     if (!in.has(i + 1)) Reader::illegal(e);
@@ -283,7 +287,8 @@ Settings parse_settings(const std::vector<std::string> &args)
           "a keyword (form, solver, precond, weight, tol, linear_tol, pass_tol, maxiter, "
           "compliance, damping, mu, mu_roll, mu_twist, rows, active_set, sweeps, "
           "sweep_tol, rescue_sweeps, min_sweeps, focus_sweeps, anderson, sweep_cg, sweep_blocks, "
-          "recovery_speed, restitution, bounce_speed, coefficients, wall, export)",
+          "recovery_speed, restitution, bounce_speed, coefficients, normal_relaxation, wall, "
+          "export)",
           &key);
     i += used;
   }
@@ -325,6 +330,7 @@ std::string describe(const Settings &s)
                        format_g(s.model.recovery_radii) + " r_min / dt without forces)"
                  : format_g(vb));
   out += std::string(", coefficients ") + to_string(s.model.coefficients);
+  out += std::string(", normal_relaxation ") + to_string(s.model.normal_relaxation);
   const FrictionParams &f = s.model.friction;
   return out + ", mu " + format_g(f.mu) + ", mu_roll " + format_g(f.mu_roll) + ", mu_twist " +
          format_g(f.mu_twist);

@@ -41,7 +41,7 @@ Vector spook_rhs(const ContactSystem &sys, const Vector *extra_dv)
   // G v, where a contact bounces or has its own damping
   Vector Gv;
   for (const Contact &k : sys.contacts())
-    if (k.restitution > 0 || k.own_damping() || k.wall_moves()) {
+    if (k.restitution > 0 || k.own_damping() || k.wall_moves() || k.implicit_normal) {
       g_apply(sys, v, Gv);
       break;
     }
@@ -83,7 +83,8 @@ Vector spook_rhs(const ContactSystem &sys, const Vector *extra_dv)
       // the partner: G_n v+ >= -gap / h.
       b[row] = std::max(std::min(b_spook, 0.0), -k.gap / p.h - vn_free);
     } else {
-      b[row] = b_spook;
+      // an implicit normal row keeps no memory of the approach speed
+      b[row] = b_spook - (k.implicit_normal ? ups_c * vn : 0.0);
     }
   }
   return b;

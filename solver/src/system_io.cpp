@@ -27,6 +27,7 @@ constexpr int kContactFieldsV5 = kContactFieldsV3 + kMaxRows;
 // version 6: + an obstacle sphere's radius (0 for a flat or region wall)
 constexpr int kContactFieldsV6 = kContactFieldsV5 + 1;
 // version 7: + the springs' own damping (rows 1..5, -1 for the contact's)
+// version 8: the same, with bit 6 of the elastic rows for an implicit normal row
 constexpr int kContactFields = kContactFieldsV6 + kMaxRows - 1;
 // Unit vectors must read back as unit vectors; exported data are far more exact than this.
 constexpr double kUnitTol = 1e-6;
@@ -237,6 +238,7 @@ void write_system(std::ostream &out, const ContactSystem &sys)
     }
     for (const Vec3 *v : {&c.wall_v, &c.wall_omega}) put_vec(s, *v);
     int elastic = c.elastic[0] ? 1 << (kMaxRows - 1) : 0;
+    if (c.implicit_normal) elastic |= 1 << kMaxRows;
     for (int r = 1; r < kMaxRows; ++r) elastic |= c.elastic[r] ? 1 << (r - 1) : 0;
     s += ' ' + std::to_string(elastic);
     for (int r = 1; r < kMaxRows; ++r) {
@@ -397,10 +399,16 @@ ContactSystem parse_system(std::string_view text)
     const long long elastic = in.integer(t[kContactFieldsV3], what + " elastic rows");
     if (version == 4 && (elastic < 0 || elastic >= (1 << (kMaxRows - 1))))
       in.fail(what + ": elastic rows must be a bit mask of rows 1 to 5, in [0, 31]");
-    if (elastic < 0 || elastic >= (1 << kMaxRows))
+    if (version <= 7 && (elastic < 0 || elastic >= (1 << kMaxRows)))
       in.fail(what + ": elastic rows must be a bit mask of rows 1 to 5 and the normal row, in [0, "
                      "63]");
+    if (elastic < 0 || elastic >= (1 << (kMaxRows + 1)))
+      in.fail(what + ": elastic rows must be a bit mask of rows 1 to 5, the normal row and its "
+                     "implicit relaxation, in [0, 127]");
     k.elastic[0] = (elastic >> (kMaxRows - 1)) & 1;
+    k.implicit_normal = (elastic >> kMaxRows) & 1;
+    if (k.implicit_normal && !k.elastic[0])
+      in.fail(what + ": an implicit normal row must be elastic (bit 5)");
     for (int r = 1; r < kMaxRows; ++r) {
       k.elastic[r] = (elastic >> (r - 1)) & 1;
       k.spring[r] = in.real(t[kContactFieldsV3 + r], what + " spring");

@@ -124,6 +124,10 @@ CASES = [
      {}),
     ("bounce_speed", "restitution 0.5 bounce_speed fast",
      "expected 'bounce_speed auto|<non-negative speed>', got 'fast'", {}),
+    ("normal_relaxation_invalid", "normal_relaxation euler",
+     "expected 'normal_relaxation law|spook', got 'euler'", {}),
+    ("normal_relaxation_missing", "normal_relaxation", "expected 'normal_relaxation law|spook'",
+     {}),
 ]
 
 

@@ -14,6 +14,7 @@
   xmu 0.2), and the log says which coefficients were read and what is not used.
 - coefficients fix: the pair style is ignored and the fix's defaults hold (mu 0.5: sticks).
 - compliance material: a resting column of spheres of hertz/material overlaps as Hertz says,
+  also with normal_relaxation law at E = 2e8 (np 1 and 2),
   d = (W / (k_n sqrt(r_eff)))^(2/3) with W the weight above each contact and k_n = 4/3 E_eff:
   every sphere's height within 1% of the overlaps below it, serial (typed) and on two
   processes (untyped: the default with pair_style granular, and the log says so); with
@@ -143,25 +144,26 @@ def drop(args, ck, rebounds, np):
                  "%s: type %d rebounds to e^2 h with native LAMMPS's e %.4f" % (tag, k, e))
 
 
-def hertz_column(args, ck, np, fix_extra):
+def hertz_column(args, ck, np, fix_extra, E=2e4, name="hertz_column"):
     """Five Hertz spheres stacked on the floor come to rest at the law's overlaps. Their
     contacts are damped by the law's dashpot (tsuji, e = 0.5), as native's: the column rings
     for seconds, as native LAMMPS's does (velocity 0.009 m/s at 3 s in both), and rests by
-    20 s."""
-    E, nu, n = 2e4, 0.3, 5
+    20 s. At E = 2e8 the dashpot is shorter than two steps, and with normal_relaxation law the
+    rows are the law's spring and dashpot by implicit Euler."""
+    nu, n = 0.3, 5
     k_n = 4.0 / 3.0 * E / (2 * (1 - nu * nu))
     atoms = [(1, 0.0, 0.5 + k) for k in range(n)]
     pair = ("pair_style granular\npair_coeff * * hertz/material %g 0.5 %g tangential mindlin "
             "NULL 1.0 0.5 damping tsuji" % (E, nu))
     lines = deck(pair, "0 0 -1", atoms, fix_extra, np, 20000).splitlines()
     lines = [ln.replace("thermo 1", "thermo 1000") for ln in lines]
-    lines.insert(-1, "dump a all custom 20000 hertz_np%d.atoms id z mass" % np)
+    tag = "%s_np%d" % (name, np)
+    lines.insert(-1, "dump a all custom 20000 %s.atoms id z mass" % tag)
     lines.insert(-1, "dump_modify a sort id format float %.17g")
-    tag = "hertz_column_np%d" % np
     run = e2e.run_lmp(args, "\n".join(lines) + "\n", tag, np=np)
     if not ck.ran(run, "%s: run completes" % tag):
         return
-    atoms = e2e.dump_by_id(e2e.parse_dump(args.workdir + "/hertz_np%d.atoms" % np)[-1])
+    atoms = e2e.dump_by_id(e2e.parse_dump(args.workdir + "/%s.atoms" % tag)[-1])
     ids = sorted(atoms)
     z_expected, worst = 0.0, 0.0
     for k, i in enumerate(ids):
@@ -232,6 +234,8 @@ def main():
             [(False, 0.5), (False, 0.5)])
     hertz_column(args, ck, 1, "compliance material")
     hertz_column(args, ck, 2, "")
+    for np in (1, 2):
+        hertz_column(args, ck, np, "normal_relaxation law", E=2e8, name="hertz_column_law")
     ck.close()
 
 

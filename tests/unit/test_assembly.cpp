@@ -101,7 +101,8 @@ TEST(Assembly, RhsMatchesFormulaAndMatrixFreeRhs)
 // A moving wall is body b with a prescribed velocity: the rhs of a system whose walls move
 // equals that of the same contacts against a real body b moving so (infinitely heavy, so
 // that its own external forces do not enter), and per-contact damping agrees between the
-// assembled and the matrix-free rhs, and so do the elastic rows' springs.
+// assembled and the matrix-free rhs, and so do the elastic rows' springs and the implicit
+// normal rows (no memory of the approach speed).
 TEST(Assembly, MovingWallsAndPerContactDamping)
 {
   SceneParams p;
@@ -114,6 +115,10 @@ TEST(Assembly, MovingWallsAndPerContactDamping)
     if (c.a % 2 == 0) { // elastic rows with their springs
       c.elastic = {false, true, true, true, true, true};
       c.spring = {0.0, 1e-4, -2e-4, 0.01, 0.02, -0.03};
+    }
+    if (c.a % 5 == 1) { // an implicit normal row
+      c.elastic[0] = c.implicit_normal = true;
+      c.damping = 0.75 + 0.2;
     }
     if (!c.is_wall()) continue;
     ++walls;

@@ -410,8 +410,10 @@ TEST(Material, NormalDampersOfTheDampingModels)
 }
 
 // A loaded contact's normal row takes the law's dashpot as its damping time (gamma_n / k_n)
-// where that is longer than SPOOK's d steps, and d where the step is too large for it; its
-// tangential springs keep the normal row's critical damping.
+// where that is longer than SPOOK's d steps; where the step is too large for it, the law's
+// spring and dashpot by implicit Euler (normal_relaxation law, SPOOK's row at 3/4 + tau / h
+// without memory), or SPOOK's d (spook). Its tangential springs keep the normal row's critical
+// damping.
 TEST(Material, LoadedContactsTakeTheLawsDashpot)
 {
   std::vector<Body> bodies(1);
@@ -434,23 +436,31 @@ TEST(Material, LoadedContactsTakeTheLawsDashpot)
   const double r = 0.25, d = 1e-3, k_n = p.k_n * std::sqrt(r * d);
   const double gamma_n = p.damping_alpha * std::sqrt(0.2 * k_n);
   Vector last = Vector::Constant(3, 0.0);
-  for (const double h : {1e-4, 1e-2}) {
-    last[0] = k_n * d * h; // the law's force at the overlap
-    apply_contact_model(model, step_of(h), 1.0, bodies, contacts, &last);
-    const Contact &c = contacts[0];
-    ASSERT_TRUE(c.elastic[0] && c.elastic[1]);
-    EXPECT_NEAR(1.0 / c.compliance[0], k_n, 1e-9 * k_n);
-    if (h == 1e-4) { // the dashpot over several steps
-      EXPECT_NEAR(c.damping, gamma_n / k_n / h, 1e-9 * c.damping);
-      EXPECT_GT(c.damping, model.damping);
-    } else { // the dashpot acts within less than d steps: SPOOK's d
-      EXPECT_LT(c.damping, 0.0);
+  for (const NormalRelaxation relaxation : {NormalRelaxation::law, NormalRelaxation::spook})
+    for (const double h : {1e-4, 1e-2}) {
+      model.normal_relaxation = relaxation;
+      last[0] = k_n * d * h; // the law's force at the overlap
+      apply_contact_model(model, step_of(h), 1.0, bodies, contacts, &last);
+      const Contact &c = contacts[0];
+      ASSERT_TRUE(c.elastic[0] && c.elastic[1]);
+      EXPECT_NEAR(1.0 / c.compliance[0], k_n, 1e-9 * k_n);
+      if (h == 1e-4) { // the dashpot over several steps
+        EXPECT_NEAR(c.damping, gamma_n / k_n / h, 1e-9 * c.damping);
+        EXPECT_GT(c.damping, model.damping);
+        EXPECT_FALSE(c.implicit_normal);
+      } else if (relaxation == NormalRelaxation::law) { // within less than d steps
+        EXPECT_TRUE(c.implicit_normal);
+        EXPECT_NEAR(c.damping, 0.75 + gamma_n / k_n / h, 1e-9);
+        EXPECT_LT(gamma_n / k_n / h, model.damping);
+      } else {
+        EXPECT_FALSE(c.implicit_normal);
+        EXPECT_LT(c.damping, 0.0);
+      }
+      // the tangential springs at least at the normal row's critical damping
+      const double critical = 2.0 * std::sqrt(0.2 * c.compliance[0]) / h;
+      EXPECT_NEAR(c.spring_damping[1], critical, 1e-9 * critical);
+      EXPECT_EQ(c.spring_damping[2], c.spring_damping[1]);
     }
-    // the tangential springs at least at the normal row's critical damping
-    const double critical = 2.0 * std::sqrt(0.2 * c.compliance[0]) / h;
-    EXPECT_NEAR(c.spring_damping[1], critical, 1e-9 * critical);
-    EXPECT_EQ(c.spring_damping[2], c.spring_damping[1]);
-  }
 }
 
 // The collision time of the elastic laws against the collision integrated by RK4 (m d'' = -F(d)

@@ -38,6 +38,7 @@ ContactSystem sample_system(int rows = 6)
   contacts[2].elastic = {true, true, true, false, true, true}; // since version 4 (5: row 0)
   contacts[2].spring = {0.0, 1.0 / 3.0, -2e-7, 0.0, 1e-300, -0.5};
   contacts[2].spring_damping = {-1.0, -1.0, -1.0, 0.0, 56.8, 56.8}; // since version 7
+  contacts[2].implicit_normal = true;                               // since version 8
   for (Contact &c : contacts) // an obstacle sphere, since version 6
     if (c.is_wall()) {
       c.wall_radius = 0.375;
@@ -91,7 +92,7 @@ void expect_identical(const ContactSystem &a, const ContactSystem &b)
                 p.friction.mu_twist == q.friction.mu_twist && p.restitution == q.restitution &&
                 p.damping == q.damping && p.wall_v == q.wall_v && p.wall_omega == q.wall_omega &&
                 p.elastic == q.elastic && p.spring == q.spring && p.wall_radius == q.wall_radius &&
-                p.spring_damping == q.spring_damping)
+                p.spring_damping == q.spring_damping && p.implicit_normal == q.implicit_normal)
         << "contact " << c;
   }
   EXPECT_EQ(a.row_mask(), b.row_mask());
@@ -162,7 +163,7 @@ TEST(SystemIo, RoundTripIsExact)
   for (int rows : {6, 3}) {
     const ContactSystem sys = sample_system(rows);
     const std::string text = to_text(sys);
-    EXPECT_EQ(text.rfind("fibre_contact_system 7\n", 0), 0u);
+    EXPECT_EQ(text.rfind("fibre_contact_system 8\n", 0), 0u);
     const ContactSystem back = parse_system(text);
     expect_identical(sys, back);
     EXPECT_EQ(to_text(back), text); // and the writer is deterministic
@@ -187,12 +188,20 @@ std::string older_version(const ContactSystem &sys, int version, int drop_spook,
       in_contacts = true;
       left = sys.num_contacts();
     } else if (in_contacts && left > 0) {
+      if (version < 8) { // no implicit normal rows: bit 6 of the elastic rows (token 32) cleared
+        std::vector<std::string> tokens;
+        std::istringstream words(line);
+        for (std::string w; words >> w;) tokens.push_back(w);
+        tokens[32] = std::to_string(std::stoi(tokens[32]) & 63);
+        line.clear();
+        for (const std::string &w : tokens) line += (line.empty() ? "" : " ") + w;
+      }
       drop(line, drop_contact);
       --left;
     }
     out += line + "\n";
   }
-  out.replace(0, std::string("fibre_contact_system 7").size(),
+  out.replace(0, std::string("fibre_contact_system " + std::to_string(kSystemFormatVersion)).size(),
               "fibre_contact_system " + std::to_string(version));
   return out;
 }
@@ -271,7 +280,9 @@ TEST(SystemIo, OlderVersionsAndCoefficientFields)
   else
     expect_error(with(38, "-2"), {"contact 0:", "0 for a pair"});
   EXPECT_EQ(parse_system(with(25, "-1")).contacts()[0].damping, -1.0);
-  expect_error(with(32, "64"), {"contact 0:", "elastic rows must be a bit mask"});
+  expect_error(with(32, "128"), {"contact 0:", "elastic rows must be a bit mask"});
+  expect_error(with(32, "64"), {"contact 0:", "an implicit normal row must be elastic"});
+  EXPECT_TRUE(parse_system(with(32, "96")).contacts()[0].implicit_normal); // since version 8
   expect_error(with(33, "0.5"), {"contact 0:", "a spring on row 1, which is not elastic"});
   const Contact elastic = parse_system(with(32, "9")).contacts()[0]; // rows 1 and 4
   EXPECT_TRUE(elastic.elastic[1] && elastic.elastic[4] && !elastic.elastic[2]);
@@ -324,7 +335,7 @@ TEST(SystemIo, EachMalformedInputGetsItsOwnError)
 
   expect_error("", {"line 1:", "unexpected end of input", "header"});
   expect_error(edit(0, "fibre_contact_sistem 1"), {"line 1:", "not a fibre_contact system"});
-  expect_error(edit(0, "fibre_contact_system 8"), {"unsupported format version 8"});
+  expect_error(edit(0, "fibre_contact_system 9"), {"unsupported format version 9"});
   expect_error(edit(0, "fibre_contact_system one"), {"'one' is not an integer"});
   expect_error(edit(2, "rows 4"), {"rows must be 3 or 6"});
   expect_error(edit(3, "spook 0 2"), {"time step h must be positive"});

@@ -28,6 +28,15 @@ struct ComplianceParams {
 // per type pair (`materials`, filled by the front end), or the model's own values for every
 // contact. Keywords the user typed override the pair style's values for every pair.
 enum class CoefficientSource { pair, fix };
+// How the normal row of a loaded material contact (compliance material) relaxes where the
+// law's dashpot is shorter than `damping` steps: spook, over `damping` steps; law, the pair
+// style's spring and dashpot by implicit Euler (Contact::implicit_normal), which does not ring
+// at any dashpot time (examples/README.md, "The normal rows by implicit Euler").
+enum class NormalRelaxation { law, spook };
+template <> struct EnumNames<NormalRelaxation> {
+  static constexpr EnumName<NormalRelaxation> table[] = {{NormalRelaxation::law, "law"},
+                                                         {NormalRelaxation::spook, "spook"}};
+};
 template <> struct EnumNames<CoefficientSource> {
   static constexpr EnumName<CoefficientSource> table[] = {{CoefficientSource::pair, "pair"},
                                                           {CoefficientSource::fix, "fix"}};
@@ -59,6 +68,7 @@ struct ContactModel {
   double bounce_speed = -1.0;
   double bounce_steps = 2.0;
   CoefficientSource coefficients = CoefficientSource::pair;
+  NormalRelaxation normal_relaxation = NormalRelaxation::spook;
   TypedCoefficients typed{};
   MaterialTable materials; // empty: the pair style gave none (or coefficients fix)
   bool per_type() const { return coefficients == CoefficientSource::pair && !materials.empty(); }

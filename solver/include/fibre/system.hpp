@@ -79,6 +79,11 @@ struct Contact {
   // overlap is the load's, not an error, so max_recovery does not bound it.
   std::array<bool, kMaxRows> elastic{};
   std::array<double, kMaxRows> spring{};
+  // An elastic normal row relaxed as the law's Kelvin-Voigt element (spring 1 / eps, dashpot
+  // time tau) by implicit Euler, G v+ (h + tau) + eps lambda / h = -gap: SPOOK's row at
+  // damping = 3/4 + tau / h without the memory Upsilon G v of the approach speed (spook_rhs).
+  // It does not ring at any tau, where SPOOK's rings below 2 steps (design section 2).
+  bool implicit_normal = false;
   // An elastic row's own SPOOK damping d (steps), or < 0 for the contact's: the pair style's
   // rolling and twisting dampers (a spring and a damper are SPOOK's compliance and damping
   // time). Rows 1..5; row 0 takes the contact's.
