@@ -28,6 +28,10 @@ struct ComplianceParams {
 // per type pair (`materials`, filled by the front end), or the model's own values for every
 // contact. Keywords the user typed override the pair style's values for every pair.
 enum class CoefficientSource { pair, fix };
+template <> struct EnumNames<CoefficientSource> {
+  static constexpr EnumName<CoefficientSource> table[] = {{CoefficientSource::pair, "pair"},
+                                                          {CoefficientSource::fix, "fix"}};
+};
 // How the normal row of a loaded material contact (compliance material) relaxes where the
 // law's dashpot is shorter than `damping` steps: spook, over `damping` steps; law, the pair
 // style's spring and dashpot by implicit Euler (Contact::implicit_normal), which does not ring
@@ -36,10 +40,6 @@ enum class NormalRelaxation { law, spook };
 template <> struct EnumNames<NormalRelaxation> {
   static constexpr EnumName<NormalRelaxation> table[] = {{NormalRelaxation::law, "law"},
                                                          {NormalRelaxation::spook, "spook"}};
-};
-template <> struct EnumNames<CoefficientSource> {
-  static constexpr EnumName<CoefficientSource> table[] = {{CoefficientSource::pair, "pair"},
-                                                          {CoefficientSource::fix, "fix"}};
 };
 struct TypedCoefficients {
   bool mu = false, mu_roll = false, mu_twist = false, restitution = false, compliance = false;
