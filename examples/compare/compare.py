@@ -14,6 +14,14 @@ Subcommands (run from anywhere; paths default to this repository):
       silo runs at several orifice diameters (with --run: runs the missing ones), the steady
       discharge rate of each, and the fit of Beverloo's law W = C rho_b sqrt(g) (D - k d)^2.5
       for each method.
+  compare.py seeds SCENE --N N --seeds S1 S2 ... [--run] [--jobs J] [--tag T]
+                 [--var NAME VALUE] [--fibre-var NAME VALUE] [--native-var NAME VALUE]
+      both twins over several seeds of fix pour (one run directory per seed,
+      WORKDIR/SCENE.N.T_sSEED; with --run: runs what is missing, J runs at a time), and per
+      twin the mean, range and standard deviation of the heap's height and angle (material) or
+      the discharge rate (silo, flowing seeds only), the wall seconds per simulated second,
+      and the fix's difference from native paired by seed with its standard error; writes
+      DIR/SCENE.N.seeds.T.md and prints it.
   compare.py picture SCENE --N N [--method M] [--when last|filled|STEP] [--out DIR]
       a PNG snapshot of a run's dump (LAMMPS dump image, coloured by height), for the README.
 
@@ -524,6 +532,118 @@ def cmd_beverloo(a):
     print("wrote " + md + " and " + png)
 
 
+# ----------------------------------------------------------------------------- seeds
+
+def paired_stats(fibre, native):
+    """Both twins' figure over seeds, paired by seed: fibre and native map a seed to a value
+    (NaN where a run has none, such as a clogged silo). Each twin's mean, range and standard
+    deviation are over its own seeds with a value; the difference fibre - native is over the
+    seeds where both have one, with the standard error of its mean (the spread of the
+    per-seed differences over sqrt(n)), and relative to native's mean over those seeds."""
+    def summary(v):
+        x = np.array([y for y in v.values() if math.isfinite(y)], dtype=float)
+        if len(x) == 0:
+            return {"n": 0, "mean": float("nan"), "min": float("nan"), "max": float("nan"),
+                    "sd": float("nan")}
+        return {"n": len(x), "mean": float(x.mean()), "min": float(x.min()),
+                "max": float(x.max()), "sd": float(x.std(ddof=1)) if len(x) > 1 else float("nan")}
+    both = [k for k in fibre if k in native and math.isfinite(fibre[k])
+            and math.isfinite(native[k])]
+    d = np.array([fibre[k] - native[k] for k in both], dtype=float)
+    base = float(np.mean([native[k] for k in both])) if both else float("nan")
+    out = {"fibre": summary(fibre), "native": summary(native), "paired": len(both)}
+    out["diff"] = float(d.mean()) if len(d) else float("nan")
+    out["diff_se"] = float(d.std(ddof=1) / math.sqrt(len(d))) if len(d) > 1 else float("nan")
+    out["rel"] = out["diff"] / base if base else float("nan")
+    out["rel_se"] = out["diff_se"] / abs(base) if base else float("nan")
+    return out
+
+
+SEED_FIGURES = {"material": (("height", "height (m)", "%.2f", True),
+                             ("angle", "angle (deg)", "%.1f", False)),
+                "silo": (("rate", "discharge rate (kg/s)", "%.2f", True),)}
+
+
+def seed_tag(a, seed):
+    return "%s_s%s" % (a.tag or "seeds", seed)
+
+
+def cmd_seeds(a):
+    variables = {m: [("seed", None)] + list(a.var or ()) for m in METHODS}
+    variables["fibre"] += list(a.fibre_var or ())
+    variables["native"] += list(a.native_var or ())
+    jobs = []
+    for seed in a.seeds:
+        tag = seed_tag(a, seed)
+        for m in METHODS:
+            logp = os.path.join(run_dir(a.workdir, a.scene, a.N, tag), log_name(a.scene, m, a.N, tag))
+            if not os.path.exists(logp):
+                if not a.run:
+                    die("missing %s (add --run)" % logp)
+                v = [("seed", seed) if k == "seed" else (k, x) for k, x in variables[m]]
+                jobs.append((m, tag, v))
+    if jobs:
+        from concurrent.futures import ThreadPoolExecutor
+        with ThreadPoolExecutor(max_workers=max(1, a.jobs)) as pool:
+            for f in [pool.submit(run_one, a, a.scene, m, a.N, tag, v) for m, tag, v in jobs]:
+                f.result()
+    figures = SEED_FIGURES[a.scene]
+    values = {m: {key: {} for key, _, _, _ in figures + (("wall", "", "", False),)}
+              for m in METHODS}
+    clogs = {m: [] for m in METHODS}
+    rows = []
+    for seed in a.seeds:
+        cells = []
+        for m in METHODS:
+            r = load_method(a, a.scene, m, a.N, seed_tag(a, seed))
+            if a.scene == "silo" and r["clogged"]:
+                clogs[m].append(seed)
+                r["rate"] = float("nan")
+            values[m]["wall"][seed] = r["wall_per_s"]
+            for key, _, fmt, _ in figures:
+                values[m][key][seed] = r[key]
+                cells.append(fmt % r[key] if math.isfinite(r[key]) else "clogged")
+            cells.append("%.2f" % r["wall_per_s"])
+        rows.append("| %s | %s |" % (seed, " | ".join(cells)))
+    head = []
+    for m in METHODS:
+        head += ["%s %s" % (m, label) for _, label, _, _ in figures] + ["%s wall s / s" % m]
+    typed = ["%s: %s" % (who, " ".join("-var %s %s" % tuple(kv) for kv in vs))
+             for who, vs in (("both", a.var), ("fix", a.fibre_var), ("native", a.native_var)) if vs]
+    lines = ["%s, N %d, %d seeds%s" % (a.scene, a.N, len(a.seeds),
+                                      "; " + "; ".join(typed) if typed else ""),
+             "", "| seed | " + " | ".join(head) + " |", "|---|" + "---|" * len(head)] + rows
+    lines += ["", "| figure | native: mean (range), sd | fix: mean (range), sd | fix - native, "
+              "paired by seed (standard error) |", "|---|---|---|---|"]
+    for key, label, fmt, relative in figures + (("wall", "wall s / simulated s", "%.2f", True),):
+        st = paired_stats(values["fibre"][key], values["native"][key])
+
+        def twin(t):
+            return ("%s (%s..%s), %s, %d seeds" % (fmt % t["mean"], fmt % t["min"],
+                                                   fmt % t["max"], fmt % t["sd"], t["n"]))
+        diff = ("%+.1f%% (%.1f%%)" % (100 * st["rel"], 100 * st["rel_se"]) if relative
+                else ("%+" + fmt[1:] + " (" + fmt + ")") % (st["diff"], st["diff_se"]))
+        lines.append("| %s | %s | %s | %s over %d seeds |" % (label, twin(st["native"]),
+                                                               twin(st["fibre"]), diff,
+                                                               st["paired"]))
+    nat, fib = (np.mean(list(values[m]["wall"].values())) for m in ("native", "fibre"))
+    lines.append("")
+    lines.append("Speed: native / fix = %.2fx (mean wall seconds per simulated second)." %
+                 (nat / fib))
+    for m in METHODS:
+        if clogs[m]:
+            lines.append("%s clogged at seeds %s." % (m, " ".join(clogs[m])))
+    lines += ["", "Made with `compare.py %s`." % " ".join(
+        "'%s'" % w if (" " in w or not w) else w for w in sys.argv[1:])]
+    text = "\n".join(lines) + "\n"
+    os.makedirs(a.out, exist_ok=True)
+    md = os.path.join(a.out, "%s.%d.seeds.%s.md" % (a.scene, a.N, a.tag or "seeds"))
+    with open(md, "w") as f:
+        f.write(text)
+    print(text)
+    print("wrote " + md)
+
+
 PICTURE_DECK = """units si
 atom_style sphere
 boundary f f f
@@ -607,6 +727,17 @@ def main():
     b.add_argument("--run", action="store_true", help="run what is missing")
     b.add_argument("--var", nargs=2, action="append", metavar=("NAME", "VALUE"))
     b.add_argument("--out", default=DEFAULT_OUT)
+    s = sub.add_parser("seeds", help="both twins over seeds, paired by seed")
+    s.add_argument("scene", choices=PILE_SCENES)
+    s.add_argument("--N", type=int, required=True)
+    s.add_argument("--seeds", nargs="+", required=True)
+    s.add_argument("--run", action="store_true", help="run what is missing")
+    s.add_argument("--jobs", type=int, default=1, help="runs at a time (%(default)s)")
+    s.add_argument("--tag", default=None, help="run directories' prefix (default: seeds)")
+    s.add_argument("--var", nargs=2, action="append", metavar=("NAME", "VALUE"))
+    s.add_argument("--fibre-var", nargs=2, action="append", metavar=("NAME", "VALUE"))
+    s.add_argument("--native-var", nargs=2, action="append", metavar=("NAME", "VALUE"))
+    s.add_argument("--out", default=DEFAULT_OUT)
     i = sub.add_parser("picture", help="PNG snapshot of a run with dump image")
     i.add_argument("scene", choices=PILE_SCENES)
     i.add_argument("--N", type=int, required=True)
@@ -622,7 +753,7 @@ def main():
     if a.np < 1:
         die("--np must be >= 1")
     {"run": cmd_run, "report": cmd_report, "beverloo": cmd_beverloo,
-     "picture": cmd_picture}[a.cmd](a)
+     "picture": cmd_picture, "seeds": cmd_seeds}[a.cmd](a)
 
 
 if __name__ == "__main__":

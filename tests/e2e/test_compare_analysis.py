@@ -6,7 +6,10 @@ curves with known answers, no LAMMPS run:
 - a flow held by an arch that lets a sphere through now and then (0.05 kg every 0.5 s, as
   seed 1031 of the D = 3.5 silo did): clogged;
 - a flow that arches for 1 s and runs on: not clogged;
-- a silo that runs empty: not clogged.
+- a silo that runs empty: not clogged;
+- the seeds' statistics (paired_stats): each twin's mean, range and spread over its own
+  seeds, the difference paired by seed with its standard error, a clogged seed (NaN) and a
+  seed one twin lacks left out of the pairs, against values worked out by hand.
 """
 
 import os
@@ -46,6 +49,21 @@ def main():
     ck.check(not clogged, "an arch that breaks again is no clog")
     _, _, _, clogged = compare.steady_rate(*curve([40.0] * 14))
     ck.check(not clogged, "a silo that runs empty is no clog")
+
+    nan = float("nan")
+    st = compare.paired_stats({"1": 5.0, "2": 5.2, "3": 4.9, "4": nan},
+                              {"1": 4.8, "2": 5.0, "3": 4.8, "5": 4.7})
+    # pairs 1..3: differences 0.2, 0.2, 0.1; sd sqrt(1/300), se 1/30; native there 4.8667
+    ck.check(st["paired"] == 3 and abs(st["diff"] - 0.5 / 3) < 1e-12
+             and abs(st["diff_se"] - 1.0 / 30) < 1e-12, "paired difference and its error",
+             "%s" % st)
+    ck.check(abs(st["rel"] - 0.5 / 14.6) < 1e-12 and abs(st["rel_se"] - 0.1 / 14.6) < 1e-12,
+             "the difference relative to native's mean over the pairs", "%s" % st)
+    f, n = st["fibre"], st["native"]
+    ck.check(f["n"] == 3 and abs(f["mean"] - 15.1 / 3) < 1e-12 and f["min"] == 4.9
+             and f["max"] == 5.2 and n["n"] == 4 and abs(n["mean"] - 4.825) < 1e-12
+             and abs(n["sd"] - 0.125830573921179) < 1e-12, "each twin over its own seeds",
+             "%s" % st)
     ck.close()
 
 
