@@ -559,37 +559,42 @@ def paired_stats(fibre, native):
     return out
 
 
+# (key in load_method's result, label, format, compared relative to native)
 SEED_FIGURES = {"material": (("height", "height (m)", "%.2f", True),
                              ("angle", "angle (deg)", "%.1f", False)),
                 "silo": (("rate", "discharge rate (kg/s)", "%.2f", True),)}
+WALL_FIGURE = ("wall_per_s", "wall s / simulated s", "%.2f", True)
 
 
 def seed_tag(a, seed):
     return "%s_s%s" % (a.tag or "seeds", seed)
 
 
-def cmd_seeds(a):
-    variables = {m: [("seed", None)] + list(a.var or ()) for m in METHODS}
-    variables["fibre"] += list(a.fibre_var or ())
-    variables["native"] += list(a.native_var or ())
+def run_missing_seeds(a):
+    """Runs (with --run) each seed's twins that have no log yet, a.jobs at a time."""
     jobs = []
     for seed in a.seeds:
         tag = seed_tag(a, seed)
         for m in METHODS:
-            logp = os.path.join(run_dir(a.workdir, a.scene, a.N, tag), log_name(a.scene, m, a.N, tag))
-            if not os.path.exists(logp):
-                if not a.run:
-                    die("missing %s (add --run)" % logp)
-                v = [("seed", seed) if k == "seed" else (k, x) for k, x in variables[m]]
-                jobs.append((m, tag, v))
+            own = a.fibre_var if m == "fibre" else a.native_var
+            logp = os.path.join(run_dir(a.workdir, a.scene, a.N, tag),
+                                log_name(a.scene, m, a.N, tag))
+            if os.path.exists(logp):
+                continue
+            if not a.run:
+                die("missing %s (add --run)" % logp)
+            jobs.append((m, tag, [("seed", seed)] + list(a.var or ()) + list(own or ())))
     if jobs:
         from concurrent.futures import ThreadPoolExecutor
         with ThreadPoolExecutor(max_workers=max(1, a.jobs)) as pool:
             for f in [pool.submit(run_one, a, a.scene, m, a.N, tag, v) for m, tag, v in jobs]:
                 f.result()
-    figures = SEED_FIGURES[a.scene]
-    values = {m: {key: {} for key, _, _, _ in figures + (("wall", "", "", False),)}
-              for m in METHODS}
+
+
+def cmd_seeds(a):
+    run_missing_seeds(a)
+    figures = SEED_FIGURES[a.scene] + (WALL_FIGURE,)
+    values = {m: {key: {} for key, _, _, _ in figures} for m in METHODS}  # seed -> value
     clogs = {m: [] for m in METHODS}
     rows = []
     for seed in a.seeds:
@@ -599,40 +604,34 @@ def cmd_seeds(a):
             if a.scene == "silo" and r["clogged"]:
                 clogs[m].append(seed)
                 r["rate"] = float("nan")
-            values[m]["wall"][seed] = r["wall_per_s"]
             for key, _, fmt, _ in figures:
                 values[m][key][seed] = r[key]
                 cells.append(fmt % r[key] if math.isfinite(r[key]) else "clogged")
-            cells.append("%.2f" % r["wall_per_s"])
         rows.append("| %s | %s |" % (seed, " | ".join(cells)))
-    head = []
-    for m in METHODS:
-        head += ["%s %s" % (m, label) for _, label, _, _ in figures] + ["%s wall s / s" % m]
     typed = ["%s: %s" % (who, " ".join("-var %s %s" % tuple(kv) for kv in vs))
              for who, vs in (("both", a.var), ("fix", a.fibre_var), ("native", a.native_var)) if vs]
+    head = ["%s %s" % (m, label) for m in METHODS for _, label, _, _ in figures]
     lines = ["%s, N %d, %d seeds%s" % (a.scene, a.N, len(a.seeds),
                                       "; " + "; ".join(typed) if typed else ""),
              "", "| seed | " + " | ".join(head) + " |", "|---|" + "---|" * len(head)] + rows
     lines += ["", "| figure | native: mean (range), sd | fix: mean (range), sd | fix - native, "
               "paired by seed (standard error) |", "|---|---|---|---|"]
-    for key, label, fmt, relative in figures + (("wall", "wall s / simulated s", "%.2f", True),):
+    for key, label, fmt, relative in figures:
         st = paired_stats(values["fibre"][key], values["native"][key])
 
         def twin(t):
-            return ("%s (%s..%s), %s, %d seeds" % (fmt % t["mean"], fmt % t["min"],
-                                                   fmt % t["max"], fmt % t["sd"], t["n"]))
-        diff = ("%+.1f%% (%.1f%%)" % (100 * st["rel"], 100 * st["rel_se"]) if relative
-                else ("%+" + fmt[1:] + " (" + fmt + ")") % (st["diff"], st["diff_se"]))
-        lines.append("| %s | %s | %s | %s over %d seeds |" % (label, twin(st["native"]),
-                                                               twin(st["fibre"]), diff,
-                                                               st["paired"]))
-    nat, fib = (np.mean(list(values[m]["wall"].values())) for m in ("native", "fibre"))
-    lines.append("")
-    lines.append("Speed: native / fix = %.2fx (mean wall seconds per simulated second)." %
-                 (nat / fib))
-    for m in METHODS:
-        if clogs[m]:
-            lines.append("%s clogged at seeds %s." % (m, " ".join(clogs[m])))
+            return "%s (%s..%s), %s, %d seeds" % (fmt % t["mean"], fmt % t["min"],
+                                                  fmt % t["max"], fmt % t["sd"], t["n"])
+        if relative:
+            diff = "%+.1f%% (%.1f%%)" % (100 * st["rel"], 100 * st["rel_se"])
+        else:
+            diff = ("%+" + fmt[1:] + " (" + fmt + ")") % (st["diff"], st["diff_se"])
+        lines.append("| %s | %s | %s | %s over %d seeds |" % (
+            label, twin(st["native"]), twin(st["fibre"]), diff, st["paired"]))
+    wall = {m: np.mean(list(values[m]["wall_per_s"].values())) for m in METHODS}
+    lines += ["", "Speed: native / fix = %.2fx (mean wall seconds per simulated second)."
+              % (wall["native"] / wall["fibre"])]
+    lines += ["%s clogged at seeds %s." % (m, " ".join(clogs[m])) for m in METHODS if clogs[m]]
     lines += ["", "Made with `compare.py %s`." % " ".join(
         "'%s'" % w if (" " in w or not w) else w for w in sys.argv[1:])]
     text = "\n".join(lines) + "\n"
