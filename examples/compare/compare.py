@@ -16,12 +16,15 @@ Subcommands (run from anywhere; paths default to this repository):
       for each method.
   compare.py seeds SCENE --N N --seeds S1 S2 ... [--run] [--jobs J] [--tag T]
                  [--var NAME VALUE] [--fibre-var NAME VALUE] [--native-var NAME VALUE]
+                 [--native-tag T0]
       both twins over several seeds of fix pour (one run directory per seed,
       WORKDIR/SCENE.N.T_sSEED; with --run: runs what is missing, J runs at a time), and per
       twin the mean, range and standard deviation of the heap's height and angle (material) or
       the discharge rate (silo, flowing seeds only), the wall seconds per simulated second,
       and the fix's difference from native paired by seed with its standard error; writes
-      DIR/SCENE.N.seeds.T.md and prints it.
+      DIR/SCENE.N.seeds.T.md and prints it. With --native-tag T0 the native twin is read
+      from (or run in) the directories of tag T0, so that several settings of the fix are
+      set against one set of native runs.
   compare.py picture SCENE --N N [--method M] [--when last|filled|STEP] [--out DIR]
       a PNG snapshot of a run's dump (LAMMPS dump image, coloured by height), for the README.
 
@@ -566,16 +569,18 @@ SEED_FIGURES = {"material": (("height", "height (m)", "%.2f", True),
 WALL_FIGURE = ("wall_per_s", "wall s / simulated s", "%.2f", True)
 
 
-def seed_tag(a, seed):
-    return "%s_s%s" % (a.tag or "seeds", seed)
+def seed_tag(a, seed, method="fibre"):
+    """The run directory's tag of a seed's twin (--native-tag: native's own)."""
+    prefix = a.native_tag if method == "native" and a.native_tag else a.tag
+    return "%s_s%s" % (prefix or "seeds", seed)
 
 
 def run_missing_seeds(a):
     """Runs (with --run) each seed's twins that have no log yet, a.jobs at a time."""
     jobs = []
     for seed in a.seeds:
-        tag = seed_tag(a, seed)
         for m in METHODS:
+            tag = seed_tag(a, seed, m)
             own = a.fibre_var if m == "fibre" else a.native_var
             logp = os.path.join(run_dir(a.workdir, a.scene, a.N, tag),
                                 log_name(a.scene, m, a.N, tag))
@@ -600,7 +605,7 @@ def cmd_seeds(a):
     for seed in a.seeds:
         cells = []
         for m in METHODS:
-            r = load_method(a, a.scene, m, a.N, seed_tag(a, seed))
+            r = load_method(a, a.scene, m, a.N, seed_tag(a, seed, m))
             if a.scene == "silo" and r["clogged"]:
                 clogs[m].append(seed)
                 r["rate"] = float("nan")
@@ -736,6 +741,8 @@ def main():
     s.add_argument("--var", nargs=2, action="append", metavar=("NAME", "VALUE"))
     s.add_argument("--fibre-var", nargs=2, action="append", metavar=("NAME", "VALUE"))
     s.add_argument("--native-var", nargs=2, action="append", metavar=("NAME", "VALUE"))
+    s.add_argument("--native-tag", default=None,
+                   help="native twin's run directories' prefix (default: --tag's)")
     s.add_argument("--out", default=DEFAULT_OUT)
     i = sub.add_parser("picture", help="PNG snapshot of a run with dump image")
     i.add_argument("scene", choices=PILE_SCENES)
