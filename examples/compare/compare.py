@@ -264,7 +264,9 @@ def repose(c):
     return height, ang, spread, fits, (cx, cy)
 
 
-def load_method(a, scene, method, n, tag=None):
+def load_method(a, scene, method, n, tag=None, history=True):
+    """A run's figures; history=False leaves out those read from every snapshot (the deepest
+    overlap, the angle over time), which only the report's table and plots use."""
     d = run_dir(a.workdir, scene, n, tag)
     logp = os.path.join(d, log_name(scene, method, n, tag))
     blocks = parse_thermo(logp)
@@ -285,6 +287,8 @@ def load_method(a, scene, method, n, tag=None):
         final = read_frames(os.path.join(d, "pile.%s.%d.dump" % (method, n)))[-1][1]
         res["final"] = final
         res["height"], res["angle"], res["angle_sd"], res["fits"], res["centre"] = repose(final)
+        if not history:
+            return res
         frames = dump_frames(d, "pile.%s.%d.traj" % (method, n)) + [(0, final)]
         res["overlap"] = overlaps(frames, floor=True)
         speed = np.sqrt(final["vx"] ** 2 + final["vy"] ** 2 + final["vz"] ** 2)
@@ -304,6 +308,8 @@ def load_method(a, scene, method, n, tag=None):
         res["m_open"] = float(m[0])
         res["rate"], res["fit0"], res["fit1"], res["clogged"] = steady_rate(t, m)
         res["left"] = float(m[-1])
+        if not history:
+            return res
         frames = dump_frames(d, "silo.%s.%d.traj" % (method, n))
         filled = os.path.join(d, "silo.%s.%d.filled.dump" % (method, n))
         if os.path.exists(filled):
@@ -605,7 +611,7 @@ def cmd_seeds(a):
     for seed in a.seeds:
         cells = []
         for m in METHODS:
-            r = load_method(a, a.scene, m, a.N, seed_tag(a, seed, m))
+            r = load_method(a, a.scene, m, a.N, seed_tag(a, seed, m), history=False)
             if a.scene == "silo" and r["clogged"]:
                 clogs[m].append(seed)
                 r["rate"] = float("nan")
