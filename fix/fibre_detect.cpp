@@ -89,6 +89,8 @@ LammpsDetection::contacts(const std::vector<fibre::Body> &bodies, double h, doub
   std::vector<fibre::DetectedContact> found;
   found.reserve(last_found_ + last_found_ / 8 + 16); // about the last step's, without regrowth
   kick_.clear();
+  speed_.resize(bodies.size());
+  for (std::size_t k = 0; k < bodies.size(); ++k) speed_[k] = fibre::free_speed(bodies[k], h);
   pair_contacts(bodies, h, damping, found);
   wall_contacts(bodies, h, damping, found);
   if (impacts) {
@@ -170,6 +172,11 @@ void LammpsDetection::pair_contacts(const std::vector<fibre::Body> &bodies, doub
       };
       if (bi >= 0 && bj >= 0) {
         const int a = tag[i] < tag[j] ? bi : bj, b = a == bi ? bj : bi;
+        // beyond the reach of is_contact (with a margin for round-off): no contact
+        const double far =
+            (1.0 + 1e-9) * fibre::pair_reach(radius[i], radius[j], speed_[a], speed_[b], h, damping,
+                                             kick(a) + kick(b));
+        if (rsq >= far * far) continue;
         fibre::Vec3 normal;
         double gap = 0.0;
         fibre::sphere_sphere_gap(bodies[a], bodies[b], normal, gap);

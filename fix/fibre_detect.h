@@ -68,6 +68,7 @@ class LammpsDetection : protected LAMMPS_NS::Pointers {
   std::vector<fibre::WallSpec> walls_;
   double wall_time_ = 0.0;
   std::vector<double> kick_;   // per body: the speed an impact may give it this step
+  std::vector<double> speed_;  // per body: its free speed over this step (fibre::free_speed)
   std::size_t last_found_ = 0; // contacts found in the last step
   std::unique_ptr<HostWalls> host_walls_;
   std::vector<int> atom_body_; // local atom -> body index, -1 if not a body

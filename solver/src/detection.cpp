@@ -23,6 +23,11 @@ bool is_contact(const Body &a, const Body *b, const Vec3 &n, double gap, double 
   return approach > 0.0 && gap < margin + (damping + 1.0) * h * approach;
 }
 
+double free_speed(const Body &b, double h)
+{
+  return (b.v + (h / b.mass) * b.force).norm();
+}
+
 double region_cutoff(const Body &b, double h, double damping, double skin, double wall_speed)
 {
   const Vec3 vfree = b.v + (h / b.mass) * b.force;

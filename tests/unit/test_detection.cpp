@@ -62,6 +62,42 @@ TEST(Detection, ApproachWithinDampingPlusOneSteps)
   EXPECT_FALSE(is_contact(rest, nullptr, n, 0.006, h, d, 0.0, -1.0));
 }
 
+// pair_reach is the front ends' cheap test before a pair's gap: every pair that is_contact
+// accepts lies within it, and for a head-on approach it is the exact bound.
+TEST(Detection, PairReachBoundsEveryContact)
+{
+  const double h = 0.01, d = 2.0;
+  // head-on at 1 m/s, radii 0.5 and 0.25: reach 0.75 + 0.0025 + 3 h * 1
+  const Body b = sphere(0.25, Vec3::Zero());
+  const Body a = sphere(0.5, Vec3(0, 0, 1), Vec3(0, 0, -1.0));
+  EXPECT_DOUBLE_EQ(free_speed(a, h), 1.0);
+  EXPECT_DOUBLE_EQ(pair_reach(0.5, 0.25, free_speed(a, h), free_speed(b, h), h, d),
+                   0.75 + 0.0025 + 0.03);
+  EXPECT_TRUE(is_contact(a, &b, Vec3::UnitZ(), 0.0025 + 0.0299, h, d));
+  EXPECT_FALSE(is_contact(a, &b, Vec3::UnitZ(), 0.0025 + 0.0301, h, d));
+  // free flight under a force counts: at rest, f/m = -100 m/s^2 gives 1 m/s over the step
+  EXPECT_DOUBLE_EQ(free_speed(sphere(0.5, Vec3::Zero(), Vec3::Zero(), Vec3(0, 0, -200.0)), h), 1.0);
+  // random pairs, motions, forces and kicks: no accepted pair lies beyond the reach
+  std::mt19937 gen(7);
+  std::uniform_real_distribution<double> u(-1.0, 1.0), r(0.1, 0.6);
+  int accepted = 0;
+  for (int k = 0; k < 20000; ++k) {
+    const Body p = sphere(r(gen), Vec3::Zero(), 3.0 * Vec3(u(gen), u(gen), u(gen)),
+                          300.0 * Vec3(u(gen), u(gen), u(gen)));
+    const Vec3 dir = Vec3(u(gen), u(gen), u(gen)).normalized();
+    const double kick = u(gen) > 0.5 ? 2.0 * (u(gen) + 1.0) : 0.0;
+    const double rq = r(gen), dist = p.radius + rq + 0.3 * (u(gen) + 1.0) - 0.05;
+    const Body q = sphere(rq, dist * dir, 3.0 * Vec3(u(gen), u(gen), u(gen)));
+    Vec3 n;
+    double gap = 0.0;
+    sphere_sphere_gap(q, p, n, gap);
+    if (!is_contact(q, &p, n, gap, h, d, kick)) continue;
+    ++accepted;
+    EXPECT_LT(dist, pair_reach(q.radius, p.radius, free_speed(q, h), free_speed(p, h), h, d, kick));
+  }
+  EXPECT_GT(accepted, 1000); // the test saw many contacts
+}
+
 TEST(Detection, PlaneWallsBothSidesWithinReach)
 {
   WallSpec w;

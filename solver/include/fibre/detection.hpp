@@ -73,6 +73,16 @@ double free_approach(const Body &a, const Body *b, const Vec3 &n, double h);
 // wall_approach: a moving wall's or obstacle's speed towards a along n (n . its velocity).
 bool is_contact(const Body &a, const Body *b, const Vec3 &n, double gap, double h, double damping,
                 double kick = 0.0, double wall_approach = 0.0);
+// A body's speed after a step of free flight, |v + h f / m|.
+double free_speed(const Body &b, double h);
+// The centre distance beyond which is_contact rejects a pair of spheres of radii ra, rb whose
+// free speeds (free_speed) are sa, sb, with the kick of is_contact: a cheap test before the
+// pair's normal and gap (most listed neighbours are far apart).
+inline double pair_reach(double ra, double rb, double sa, double sb, double h, double damping,
+                         double kick = 0.0)
+{
+  return ra + rb + kContactMargin * (ra < rb ? ra : rb) + (damping + 1.0) * h * (kick + sa + sb);
+}
 
 // How far from a sphere a region wall is looked for: its radius, the margin, and its
 // free-flight reach over (damping + 1) steps, capped at the neighbour skin; wall_speed bounds
