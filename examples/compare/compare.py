@@ -16,7 +16,7 @@ Subcommands (run from anywhere; paths default to this repository):
       for each method.
   compare.py seeds SCENE --N N --seeds S1 S2 ... [--run] [--jobs J] [--tag T]
                  [--var NAME VALUE] [--fibre-var NAME VALUE] [--native-var NAME VALUE]
-                 [--native-tag T0]
+                 [--native-tag T0] [--against-tag T1]
       both twins over several seeds of fix pour (one run directory per seed,
       WORKDIR/SCENE.N.T_sSEED; with --run: runs what is missing, J runs at a time), and per
       twin the mean, range and standard deviation of the heap's height and angle (material) or
@@ -24,7 +24,9 @@ Subcommands (run from anywhere; paths default to this repository):
       and the fix's difference from native paired by seed with its standard error; writes
       DIR/SCENE.N.seeds.T.md and prints it. With --native-tag T0 the native twin is read
       from (or run in) the directories of tag T0, so that several settings of the fix are
-      set against one set of native runs.
+      set against one set of native runs. With --against-tag T1 the fix's runs are also
+      paired by seed with the fix's runs of tag T1 (another setting of the fix, the same
+      seeds), and the table gains their difference.
   compare.py picture SCENE --N N [--method M] [--when last|filled|STEP] [--out DIR]
       a PNG snapshot of a run's dump (LAMMPS dump image, coloured by height), for the README.
 
@@ -627,18 +629,35 @@ def cmd_seeds(a):
              "", "| seed | " + " | ".join(head) + " |", "|---|" + "---|" * len(head)] + rows
     lines += ["", "| figure | native: mean (range), sd | fix: mean (range), sd | fix - native, "
               "paired by seed (standard error) |", "|---|---|---|---|"]
+
+    def difference(st, fmt, relative):
+        if relative:
+            return "%+.1f%% (%.1f%%)" % (100 * st["rel"], 100 * st["rel_se"])
+        return ("%+" + fmt[1:] + " (" + fmt + ")") % (st["diff"], st["diff_se"])
     for key, label, fmt, relative in figures:
         st = paired_stats(values["fibre"][key], values["native"][key])
 
         def twin(t):
             return "%s (%s..%s), %s, %d seeds" % (fmt % t["mean"], fmt % t["min"],
                                                   fmt % t["max"], fmt % t["sd"], t["n"])
-        if relative:
-            diff = "%+.1f%% (%.1f%%)" % (100 * st["rel"], 100 * st["rel_se"])
-        else:
-            diff = ("%+" + fmt[1:] + " (" + fmt + ")") % (st["diff"], st["diff_se"])
         lines.append("| %s | %s | %s | %s over %d seeds |" % (
-            label, twin(st["native"]), twin(st["fibre"]), diff, st["paired"]))
+            label, twin(st["native"]), twin(st["fibre"]), difference(st, fmt, relative), st["paired"]))
+    if a.against_tag:
+        # the fix's runs of another setting, read as they are (no --run)
+        other = {key: {} for key, _, _, _ in figures}
+        for seed in a.seeds:
+            tag = "%s_s%s" % (a.against_tag, seed)
+            r = load_method(a, a.scene, "fibre", a.N, tag, history=False)
+            if a.scene == "silo" and r["clogged"]:
+                r["rate"] = float("nan")
+            for key, _, _, _ in figures:
+                other[key][seed] = r[key]
+        lines += ["", "| figure | fix (%s) - fix (%s), paired by seed (standard error) |"
+                  % (a.tag or "seeds", a.against_tag), "|---|---|"]
+        for key, label, fmt, relative in figures:
+            st = paired_stats(values["fibre"][key], other[key])
+            lines.append("| %s | %s over %d seeds |" % (label, difference(st, fmt, relative),
+                                                          st["paired"]))
     wall = {m: np.mean(list(values[m]["wall_per_s"].values())) for m in METHODS}
     lines += ["", "Speed: native / fix = %.2fx (mean wall seconds per simulated second)."
               % (wall["native"] / wall["fibre"])]
@@ -749,6 +768,8 @@ def main():
     s.add_argument("--native-var", nargs=2, action="append", metavar=("NAME", "VALUE"))
     s.add_argument("--native-tag", default=None,
                    help="native twin's run directories' prefix (default: --tag's)")
+    s.add_argument("--against-tag", default=None,
+                   help="also pair the fix with the fix's runs of this prefix")
     s.add_argument("--out", default=DEFAULT_OUT)
     i = sub.add_parser("picture", help="PNG snapshot of a run with dump image")
     i.add_argument("scene", choices=PILE_SCENES)
