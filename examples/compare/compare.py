@@ -641,7 +641,8 @@ def cmd_seeds(a):
             return "%s (%s..%s), %s, %d seeds" % (fmt % t["mean"], fmt % t["min"],
                                                   fmt % t["max"], fmt % t["sd"], t["n"])
         lines.append("| %s | %s | %s | %s over %d seeds |" % (
-            label, twin(st["native"]), twin(st["fibre"]), difference(st, fmt, relative), st["paired"]))
+            label, twin(st["native"]), twin(st["fibre"]), difference(st, fmt, relative),
+            st["paired"]))
     if a.against_tag:
         # the fix's runs of another setting, read as they are (no --run)
         other = {key: {} for key, _, _, _ in figures}

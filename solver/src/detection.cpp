@@ -30,9 +30,8 @@ double free_speed(const Body &b, double h)
 
 double region_cutoff(const Body &b, double h, double damping, double skin, double wall_speed)
 {
-  const Vec3 vfree = b.v + (h / b.mass) * b.force;
   return b.radius * (1.0 + kContactMargin) +
-         std::min(skin, (damping + 1.0) * h * (vfree.norm() + wall_speed));
+         std::min(skin, (damping + 1.0) * h * (free_speed(b, h) + wall_speed));
 }
 
 double WallSpec::offset(double t) const

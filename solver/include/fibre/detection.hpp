@@ -77,7 +77,7 @@ bool is_contact(const Body &a, const Body *b, const Vec3 &n, double gap, double 
 double free_speed(const Body &b, double h);
 // The centre distance beyond which is_contact rejects a pair of spheres of radii ra, rb whose
 // free speeds (free_speed) are sa, sb, with the kick of is_contact: a cheap test before the
-// pair's normal and gap (most listed neighbours are far apart).
+// pair's normal and gap (many listed neighbours are further apart).
 inline double pair_reach(double ra, double rb, double sa, double sb, double h, double damping,
                          double kick = 0.0)
 {
