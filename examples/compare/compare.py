@@ -577,10 +577,20 @@ SEED_FIGURES = {"material": (("height", "height (m)", "%.2f", True),
 WALL_FIGURE = ("wall_per_s", "wall s / simulated s", "%.2f", True)
 
 
-def seed_tag(a, seed, method="fibre"):
-    """The run directory's tag of a seed's twin (--native-tag: native's own)."""
-    prefix = a.native_tag if method == "native" and a.native_tag else a.tag
+def seed_tag(a, seed, method="fibre", prefix=None):
+    """The run directory's tag of a seed's twin: prefix's, else --native-tag's for native,
+    else --tag's."""
+    if prefix is None:
+        prefix = a.native_tag if method == "native" and a.native_tag else a.tag
     return "%s_s%s" % (prefix or "seeds", seed)
+
+
+def seed_figures(a, method, tag):
+    """One seed's run, its end figures only; a clogged silo's rate is NaN."""
+    r = load_method(a, a.scene, method, a.N, tag, history=False)
+    if a.scene == "silo" and r["clogged"]:
+        r["rate"] = float("nan")
+    return r
 
 
 def run_missing_seeds(a):
@@ -613,10 +623,9 @@ def cmd_seeds(a):
     for seed in a.seeds:
         cells = []
         for m in METHODS:
-            r = load_method(a, a.scene, m, a.N, seed_tag(a, seed, m), history=False)
+            r = seed_figures(a, m, seed_tag(a, seed, m))
             if a.scene == "silo" and r["clogged"]:
                 clogs[m].append(seed)
-                r["rate"] = float("nan")
             for key, _, fmt, _ in figures:
                 values[m][key][seed] = r[key]
                 cells.append(fmt % r[key] if math.isfinite(r[key]) else "clogged")
@@ -634,23 +643,20 @@ def cmd_seeds(a):
         if relative:
             return "%+.1f%% (%.1f%%)" % (100 * st["rel"], 100 * st["rel_se"])
         return ("%+" + fmt[1:] + " (" + fmt + ")") % (st["diff"], st["diff_se"])
+
+    def twin(t, fmt):
+        return "%s (%s..%s), %s, %d seeds" % (fmt % t["mean"], fmt % t["min"], fmt % t["max"],
+                                              fmt % t["sd"], t["n"])
     for key, label, fmt, relative in figures:
         st = paired_stats(values["fibre"][key], values["native"][key])
-
-        def twin(t):
-            return "%s (%s..%s), %s, %d seeds" % (fmt % t["mean"], fmt % t["min"],
-                                                  fmt % t["max"], fmt % t["sd"], t["n"])
         lines.append("| %s | %s | %s | %s over %d seeds |" % (
-            label, twin(st["native"]), twin(st["fibre"]), difference(st, fmt, relative),
-            st["paired"]))
+            label, twin(st["native"], fmt), twin(st["fibre"], fmt),
+            difference(st, fmt, relative), st["paired"]))
     if a.against_tag:
         # the fix's runs of another setting, read as they are (no --run)
         other = {key: {} for key, _, _, _ in figures}
         for seed in a.seeds:
-            tag = "%s_s%s" % (a.against_tag, seed)
-            r = load_method(a, a.scene, "fibre", a.N, tag, history=False)
-            if a.scene == "silo" and r["clogged"]:
-                r["rate"] = float("nan")
+            r = seed_figures(a, "fibre", seed_tag(a, seed, prefix=a.against_tag))
             for key, _, _, _ in figures:
                 other[key][seed] = r[key]
         lines += ["", "| figure | fix (%s) - fix (%s), paired by seed (standard error) |"
