@@ -50,10 +50,13 @@ for np in $nps; do
   # shellcheck disable=SC2086
   mpirun $mpirun_flags $over -np "$np" "$lmp" -in "in.$deck" -var N "$N" $timevar -var fc_extra "$extra" \
     -log "$log" -screen none > "out.np$np" 2>&1 || { echo "np $np failed, see $work/out.np$np"; continue; }
-  loop=$(sed -n 's/^Loop time of \([0-9.e+-]*\) on .*/\1/p' "$log" | tail -1)
-  steps=$(sed -n 's/.* for \([0-9]*\) steps with .*/\1/p' "$log" | tail -1)
+  # the last run with steps and its timing breakdown (the silo's fill is followed by a run 0)
+  last=$(awk '/^Loop time of/ { keep = $9 > 0; if (keep) s = "" } keep { s = s $0 "\n" }
+              END { printf "%s", s }' "$log")
+  loop=$(sed -n 's/^Loop time of \([0-9.e+-]*\) on .*/\1/p' <<< "$last")
+  steps=$(sed -n 's/.* for \([0-9]*\) steps with .*/\1/p' <<< "$last")
   timing=$(sed -n 's/^fibre_timing setup_per_step \([^ ]*\) solve_per_step \([^ ]*\) sweep_per_step \([^ ]*\)/\1 \2 \3/p' "$log" | tail -1)
-  pct() { awk -v k="$1" '$1 == k && $2 == "|" { print $NF }' "$log" | tail -1; }
+  pct() { awk -v k="$1" '$1 == k && $2 == "|" { print $NF }' <<< "$last" | tail -1; }
   [ -z "$t1" ] && t1=$loop && p1=$np
   awk -v np="$np" -v loop="$loop" -v t1="$t1" -v p1="$p1" -v tm="$timing" \
       -v pair="$(pct Pair)" -v neigh="$(pct Neigh)" -v comm="$(pct Comm)" \
