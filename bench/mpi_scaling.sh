@@ -13,6 +13,8 @@
 #   --lmp PATH          lmp_fibre (default build/fix/lmp_fibre)
 #   --work DIR          work directory (default /tmp/fibre_mpi_scaling)
 #   --extra "KEYS"      more fix fibre_contact keywords (-var fc_extra), e.g. "precond fibre"
+#   --balance K         rebalance the processes' domains every K steps (fix balance K 1.05
+#                       shift xyz 10 1.05; the decks' piles fill few cells of a uniform grid)
 #   --mpirun-flags "F"  flags for mpirun (default: --mca btl_vader_single_copy_mechanism none,
 #                       see below; pass "" for Open MPI's defaults)
 # Open MPI's shared-memory transport copies messages above its 4 KB eager limit with a
@@ -33,15 +35,19 @@ tend=2.0
 lmp=$src/build/fix/lmp_fibre
 work=/tmp/fibre_mpi_scaling
 extra=""
+balance=0
 mpirun_flags="--mca btl_vader_single_copy_mechanism none"
 parse_options "$0" "$@"
 nps=$np
 enter_work "$src"
+if [ "$balance" -gt 0 ]; then
+  sed -i "s/^include  *run\.$deck/fix       fc_balance all balance $balance 1.05 shift xyz 10 1.05\n&/" "in.$deck"
+fi
 
 echo "mpi_scaling: $(date -u '+%Y-%m-%d %H:%M UTC'), $(hostname), $cores cores;" \
-     "deck $deck N $N tend $tend, extra '$extra', mpirun flags '$mpirun_flags'"
-printf '%4s %10s %8s %8s %10s %10s %10s %8s %8s %8s %8s %8s\n' np loop_s speedup eff \
-  setup_ms/st solve_ms/st sweep_ms/st pair% neigh% comm% modify% other%
+     "deck $deck N $N tend $tend, extra '$extra', balance $balance, mpirun flags '$mpirun_flags'"
+printf '%4s %10s %8s %8s %10s %10s %10s %9s %8s %8s %8s %8s %8s\n' np loop_s speedup eff \
+  setup_ms/st solve_ms/st sweep_ms/st sweeps/st pair% neigh% comm% modify% other%
 t1=""
 for np in $nps; do
   over=""
@@ -55,7 +61,7 @@ for np in $nps; do
               END { printf "%s", s }' "$log")
   loop=$(sed -n 's/^Loop time of \([0-9.e+-]*\) on .*/\1/p' <<< "$last")
   steps=$(sed -n 's/.* for \([0-9]*\) steps with .*/\1/p' <<< "$last")
-  timing=$(sed -n 's/^fibre_timing setup_per_step \([^ ]*\) solve_per_step \([^ ]*\) sweep_per_step \([^ ]*\)/\1 \2 \3/p' "$log" | tail -1)
+  timing=$(sed -n 's/^fibre_timing setup_per_step \([^ ]*\) solve_per_step \([^ ]*\) sweep_per_step \([^ ]*\) sweeps_per_step \([^ ]*\)/\1 \2 \3 \4/p' "$log" | tail -1)
   pct() { awk -v k="$1" '$1 == k && $2 == "|" { print $NF }' <<< "$last" | tail -1; }
   [ -z "$t1" ] && t1=$loop && p1=$np
   awk -v np="$np" -v loop="$loop" -v t1="$t1" -v p1="$p1" -v tm="$timing" \
@@ -63,8 +69,8 @@ for np in $nps; do
       -v modify="$(pct Modify)" -v other="$(pct Other)" 'BEGIN {
     split(tm, t, " ");
     s = t1 / loop; e = s * p1 / np;
-    printf "%4d %10.2f %8.2f %7.0f%% %10.2f %10.2f %10.2f %8s %8s %8s %8s %8s\n", np, loop, s,
-      100 * e, 1e3 * t[1], 1e3 * t[2], 1e3 * t[3], pair, neigh, comm, modify, other }'
+    printf "%4d %10.2f %8.2f %7.0f%% %10.2f %10.2f %10.2f %9.1f %8s %8s %8s %8s %8s\n", np, loop, s,
+      100 * e, 1e3 * t[1], 1e3 * t[2], 1e3 * t[3], t[4], pair, neigh, comm, modify, other }'
   echo "     ($steps steps; LAMMPS log $work/$log)"
 done
 echo "eff = T(first) * np(first) / (np * T): parallel efficiency of the loop time"

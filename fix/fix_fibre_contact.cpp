@@ -738,6 +738,15 @@ void FixFibreContact::unpack_reverse_comm(int n, int *list, double *buf)
   exchange_->unpack_reverse(n, list, buf);
 }
 
+#ifndef FIBRE_HOST_LIGGGHTS
+// The variable-size reverse comm's buffers (fix/lammps_compat.h): LAMMPS sizes none for a
+// fix's reverse comm under `newton off`.
+int FixFibreContact::pack_reverse_comm_size(int n, int /*first*/)
+{
+  return n * fibre_lmp::LammpsExchange::kValuesPerAtom;
+}
+#endif
+
 /* ---------------------------------------------------------------------- */
 
 double FixFibreContact::memory_usage()

@@ -53,6 +53,9 @@ class FixFibreContact : public Fix {
   void FIBRE_UNPACK_FORWARD(int, int, double *) override;
   int pack_reverse_comm(int, int, double *) override;
   void unpack_reverse_comm(int, int *, double *) override;
+#ifndef FIBRE_HOST_LIGGGHTS
+  int pack_reverse_comm_size(int, int) override;
+#endif
 
   double memory_usage() override;
 

@@ -233,7 +233,7 @@ Mat6 diagonal_block(const ContactSystem &sys, int c)
   return D;
 }
 
-Vec6 diagonal_entries(const ContactSystem &sys, int c)
+Vec6 diagonal_entries(const ContactSystem &sys, int c, double split_a, double split_b)
 {
   const Contact &k = sys.contacts()[c];
   const ContactKinematics &q = sys.kinematics(c);
@@ -244,13 +244,15 @@ Vec6 diagonal_entries(const ContactSystem &sys, int c)
   for (int r = 0; r < rows; ++r) d[r] = sys.sigma()[Eigen::Index(rows) * c + r];
   for (int side = 0; side < (k.is_wall() ? 1 : 2); ++side) {
     const double *m = sys.inv_mass().data() + 6 * std::size_t(side == 0 ? k.a : k.b);
+    const double split = side == 0 ? split_a : split_b;
     const Vec3 &lever = side == 0 ? q.ra : q.rb;
     for (int i = 0; i < 3; ++i) {
       const Vec3 n = q.frame.row(i).transpose(), t = lever.cross(n);
       const double rot = n[0] * n[0] * m[3] + n[1] * n[1] * m[4] + n[2] * n[2] * m[5];
-      d[i] += wt[i] * (n[0] * n[0] * m[0] + n[1] * n[1] * m[1] + n[2] * n[2] * m[2] +
-                       t[0] * t[0] * m[3] + t[1] * t[1] * m[4] + t[2] * t[2] * m[5]);
-      if (i + 3 < rows) d[i + 3] += wt[i + 3] * rot;
+      d[i] += split * wt[i] *
+              (n[0] * n[0] * m[0] + n[1] * n[1] * m[1] + n[2] * n[2] * m[2] + t[0] * t[0] * m[3] +
+               t[1] * t[1] * m[4] + t[2] * t[2] * m[5]);
+      if (i + 3 < rows) d[i + 3] += split * wt[i + 3] * rot;
     }
   }
   return d;

@@ -7,6 +7,7 @@
 
 #include "fibre/contact_rows.hpp"
 #include "fibre/fibre_blocks.hpp"
+#include "fibre/kernels.hpp"
 #include "fibre/spook.hpp"
 
 namespace fibre {
@@ -52,13 +53,13 @@ namespace {
 // (rows per contact; a full sweep only). The rows of G are applied in
 // their structured form (contact_rows.hpp).
 template <int R>
-void sweep(const ContactSystem &sys, const Cones &cones, const Vector &b,
+void sweep(const ContactSystem &sys, const Cones &cones, const Vector &b, const double *inv_mass,
            const std::vector<Vec6> &inv_scale, const std::vector<int> &owners, const int *list,
            int count, Vector &lambda, Vector &dv, double norms[2], double *changes, double *steps)
 {
   const int *pairs = sys.body_pairs();
   const double *kin = sys.num_contacts() > 0 ? sys.kinematics(0).frame.data() : nullptr;
-  const double *inv_mass = sys.inv_mass().data(), *sigma = sys.sigma().data();
+  const double *sigma = sys.sigma().data();
   double *l = lambda.data(), *w = dv.data();
   for (int k = 0; k < count; ++k) {
     const int c = list ? list[k] : k;
@@ -98,6 +99,27 @@ void sweep(const ContactSystem &sys, const Cones &cones, const Vector &b,
       for (int d = 0; d < 6; ++d) wb[d] += mb[d] * yb[d];
     }
   }
+}
+
+// Mass splitting (pgs.hpp): per body, 6 entries each, the number of processes whose contacts
+// move it (at least 1), on its owner and its ghosts. Empty where no body is shared.
+Vector body_splits(const ContactSystem &sys, const Exchange &ex)
+{
+  const std::vector<int> &owners = ex.local_owners();
+  const int *pairs = sys.body_pairs();
+  Vector split = Vector::Zero(sys.body_dofs());
+  for (int c = 0; c < sys.num_contacts(); ++c)
+    for (int side = 0; side < 2; ++side) {
+      int body = pairs[2 * std::size_t(c) + side];
+      if (body < 0) continue;
+      if (!owners.empty()) body = owners[body];
+      split.segment<kBodyDofs>(Eigen::Index(kBodyDofs) * body).setOnes();
+    }
+  ex.reverse_sum(split);
+  ex.forward(split);
+  split = split.cwiseMax(1.0);
+  const double shared = ex.max(split.size() ? split.maxCoeff() : 1.0);
+  return shared > 1.0 ? split : Vector();
 }
 
 // The contacts that a full sweep moved by at least kFocusShare of its mean change^2: those
@@ -249,8 +271,33 @@ PgsResult pgs(const ContactSystem &sys, const Exchange &ex, const Cones &cones, 
 {
   PgsResult res;
   const int nc = sys.num_contacts(), rows = sys.rows();
+  // Mass splitting: the sweeps see a shared body's copy, of inverse mass split / m. Not with
+  // fibre blocks, whose corrections move their bodies at their own mass, nor with nonlinear
+  // CG, whose steps along its direction it slowed (12 of test_fix_solvers' 60 steps at np 2
+  // unconverged).
+  const bool halo = ex.has_halo(); // else the round trip below is the identity
+  const Vector split =
+      halo && !control.fibre_blocks && !control.nonlinear_cg ? body_splits(sys, ex) : Vector();
+  Vector split_inv_mass;
   std::vector<Vec6> inv_scale(scale.size());
-  for (std::size_t c = 0; c < scale.size(); ++c) inv_scale[c] = scale[c].cwiseInverse();
+  if (split.size()) {
+    split_inv_mass = sys.inv_mass().cwiseProduct(split);
+    const std::vector<int> &owners = ex.local_owners();
+    const auto split_of = [&](int body) {
+      if (body < 0) return 1.0;
+      return split[Eigen::Index(kBodyDofs) * (owners.empty() ? body : owners[body])];
+    };
+    std::vector<Vec6> diagonal(nc);
+    for (int c = 0; c < nc; ++c) {
+      const Contact &k = sys.contacts()[c];
+      diagonal[c] = diagonal_entries(sys, c, split_of(k.a), split_of(k.b));
+    }
+    const std::vector<Vec6> split_scale = row_scales(diagonal, rows);
+    for (int c = 0; c < nc; ++c) inv_scale[c] = split_scale[c].cwiseInverse();
+  } else {
+    for (std::size_t c = 0; c < scale.size(); ++c) inv_scale[c] = scale[c].cwiseInverse();
+  }
+  const double *inv_mass = split.size() ? split_inv_mass.data() : sys.inv_mass().data();
   // the blocks read their bound rows from feasible impulses
   if (control.fibre_blocks)
     for (int c = 0; c < nc; ++c) cones.project(lambda.data() + Eigen::Index(rows) * c, c);
@@ -272,7 +319,6 @@ PgsResult pgs(const ContactSystem &sys, const Exchange &ex, const Cones &cones, 
     blocks =
         std::make_unique<FibreBlocks>(sys, ex.local_owners(), cones, control.block_weight, &normal);
   }
-  const bool halo = ex.has_halo(); // else the round trip below is the identity
   // the blocks' corrections are not part of the sweeps' steps, and measured with them the
   // combination diverged on a stiff pile: plain sweeps only
   const bool accelerate = control.anderson > 0 && !control.nonlinear_cg && !blocks;
@@ -299,16 +345,18 @@ PgsResult pgs(const ContactSystem &sys, const Exchange &ex, const Cones &cones, 
     // from its last sweep on
     const bool mixing = accelerate && s + 1 >= control.min_sweeps;
     if (rows == 6)
-      sweep<6>(sys, cones, b, inv_scale, ex.local_owners(), list, count, lambda, dv, norms, changes,
-               mixing ? steps.data() : nullptr);
+      sweep<6>(sys, cones, b, inv_mass, inv_scale, ex.local_owners(), list, count, lambda, dv,
+               norms, changes, mixing ? steps.data() : nullptr);
     else
-      sweep<3>(sys, cones, b, inv_scale, ex.local_owners(), list, count, lambda, dv, norms, changes,
-               mixing ? steps.data() : nullptr);
+      sweep<3>(sys, cones, b, inv_mass, inv_scale, ex.local_owners(), list, count, lambda, dv,
+               norms, changes, mixing ? steps.data() : nullptr);
     if (changes) focus_list(contact_changes, norms[0], focus_contacts);
     res.visits += count;
-    // Every process's updates on every body: the sum of the local changes, owners and ghosts.
+    // Every process's updates on every body: the sum of the local changes, owners and ghosts
+    // (each copy's change at the body's own mass).
     if (halo) {
       moved = dv - dv_start;
+      if (split.size()) moved.array() /= split.array();
       ex.reverse_sum(moved);
       ex.forward(moved);
       dv = dv_start + moved;

@@ -240,6 +240,62 @@ TEST(Pgs, PeriodicImagesAreOneBody)
 
 namespace {
 
+// Two processes in one: body 1 is the other process's copy (a ghost) of body 0. forward copies
+// 0 to 1, reverse_sum adds 1 into 0; no local owners, so each copy relaxes apart within a sweep
+// as on two processes.
+class CopyExchange final : public Exchange {
+ public:
+  void forward(Vector &v) const override { v.segment<6>(6) = v.segment<6>(0); }
+  void reverse_sum(Vector &v) const override
+  {
+    v.segment<6>(0) += v.segment<6>(6);
+    v.segment<6>(6).setZero();
+  }
+  void sum(double *, int) const override {}
+  void max(double *, int) const override {}
+  long exclusive_prefix_sum(long) const override { return 0; }
+};
+
+} // namespace
+
+// A sphere landing on a floor whose two halves meet under it, one contact on each process.
+// Each process alone stops the whole sphere, and together they overshoot: block Jacobi swings
+// between twice the needed impulse and none for ever. Split into two copies of half the mass,
+// each contact takes half the impulse of one contact on one process, at once.
+TEST(Pgs, MassSplittingStopsSharedBodiesFromOvershooting)
+{
+  std::vector<Body> one(1);
+  one[0].mass = 2.0;
+  one[0].radius = 0.5;
+  one[0].v = Vec3(0.1, 0, -1.0);
+  one[0].force = Vec3(0, 0, -9.81 * one[0].mass);
+  std::vector<Contact> floor{sphere_wall_contact(one, 0, Vec3::UnitZ(), 0.5)};
+  floor[0].compliance.fill(1e-10);
+  floor[0].friction = FrictionParams{0.0, 0.0, 0.0};
+  SpookParams params;
+  params.h = 1e-2;
+  const ContactSystem serial(one, floor, 3, params);
+  Vector whole = Vector::Zero(serial.contact_dofs());
+  pgs(serial, serial_exchange(), Cones(serial), spook_rhs(serial), row_scales(serial), whole,
+      PgsControl{10, 1e-14, 10});
+  ASSERT_GT(whole[0], 0.0);
+
+  std::vector<Body> two{one[0], one[0]}; // the body and the other process's copy
+  std::vector<Contact> halves{floor[0], floor[0]};
+  halves[1].a = 1;
+  const ContactSystem split(two, halves, 3, params, 1);
+  Vector lambda = Vector::Zero(split.contact_dofs());
+  const PgsResult res = pgs(split, CopyExchange(), Cones(split), spook_rhs(split),
+                            row_scales(split), lambda, PgsControl{50, 1e-12, 50});
+  EXPECT_EQ(res.reason, StopReason::converged);
+  EXPECT_LE(res.sweeps, 3);
+  // (two contacts in parallel are twice as stiff: Sigma / (1 / m) = 9e-7 apart)
+  EXPECT_NEAR(lambda[0], 0.5 * whole[0], 1e-5 * whole[0]);
+  EXPECT_NEAR(lambda[3], 0.5 * whole[0], 1e-5 * whole[0]);
+}
+
+namespace {
+
 // A column of n spheres (radius 0.5) on a floor, its contacts listed from the top down: the
 // order in which point sweeps carry the load down most slowly.
 ContactSystem column(int n)

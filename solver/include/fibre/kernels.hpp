@@ -27,8 +27,9 @@ Mat6 jacobian_block(const ContactSystem &sys, int c, int side);
 // Rows/columns beyond rows() are identity.
 Mat6 diagonal_block(const ContactSystem &sys, int c);
 // Its diagonal alone, from the rows' structure (about 10x cheaper than the block): what the
-// sweeps' row scales and the active set's trial impulses need every step.
-Vec6 diagonal_entries(const ContactSystem &sys, int c);
+// sweeps' row scales and the active set's trial impulses need every step. split_a, split_b
+// multiply the bodies' inverse masses (the sweeps' mass splitting across processes, pgs.hpp).
+Vec6 diagonal_entries(const ContactSystem &sys, int c, double split_a = 1.0, double split_b = 1.0);
 // Coupling block A_cd = sum over bodies j shared by c and d of G_cj M_j^-1 G_dj^T
 // (rows() x rows() in the top-left corner, zero elsewhere). Zero if they share no body.
 Mat6 coupling_block(const ContactSystem &sys, int c, int d);
