@@ -176,9 +176,9 @@ class RingExchange final : public Exchange {
 // from both sides, through the contacts A-B and C-A', on two copies of A. The SPOOK step
 // (d = 2, gaps 0) asks G v+ = G v / 9 of both pressing rows: with masses 1, 1.5, 2 and
 // approach speeds 1, lambda = (40/27, 128/81). With local_owners() the sweeps update A in place
-// (Gauss-Seidel on the one body); relaxing A' apart from A within a sweep (Jacobi across the
-// boundary) converges more slowly (the shear cell of examples/shear stalled at a residual of
-// 0.05 and blew up).
+// (Gauss-Seidel on the one body); relaxing A' apart from A within a sweep converges more slowly:
+// as Jacobi across the boundary the shear cell of examples/shear stalled at a residual of 0.05
+// and blew up, and as two mass-split copies (what processes do) it is still slower.
 TEST(Pgs, PeriodicImagesAreOneBody)
 {
   const double xs[4] = {0.0, 1.0, 2.0, 3.0}; // A, B, C, A'
