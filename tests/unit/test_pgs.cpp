@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdio>
 #include <limits>
+#include <utility>
 
 #include "fibre/apgd.hpp"
 #include "fibre/nonsmooth_reference.hpp"
@@ -152,22 +153,29 @@ TEST(Pgs, AsTheStepSolver)
 
 namespace {
 
-// One process holding a periodic image (LAMMPS's serial periodic runs): bodies 0..2 owned,
-// body 3 the ghost of body 0 across the boundary. forward copies 0 to 3, reverse_sum adds 3
-// into 0, and local_owners() names body 0 as the image's body.
-class RingExchange final : public Exchange {
+// One process whose body `ghost` is a ghost of body 0: forward copies 0 to it, reverse_sum
+// adds it into 0. With `owners` naming body 0 as its body it is a periodic image on the same
+// process (LAMMPS's serial periodic runs); without, it relaxes apart from body 0 within a sweep
+// as the other process's copy does.
+class GhostOfBodyZero final : public Exchange {
  public:
-  void forward(Vector &v) const override { v.segment<6>(18) = v.segment<6>(0); }
+  GhostOfBodyZero(int ghost, std::vector<int> owners) : owners(std::move(owners)), ghost_(6 * ghost)
+  {
+  }
+  void forward(Vector &v) const override { v.segment<6>(ghost_) = v.segment<6>(0); }
   void reverse_sum(Vector &v) const override
   {
-    v.segment<6>(0) += v.segment<6>(18);
-    v.segment<6>(18).setZero();
+    v.segment<6>(0) += v.segment<6>(ghost_);
+    v.segment<6>(ghost_).setZero();
   }
   void sum(double *, int) const override {}
   void max(double *, int) const override {}
   long exclusive_prefix_sum(long) const override { return 0; }
   const std::vector<int> &local_owners() const override { return owners; }
-  std::vector<int> owners{0, 1, 2, 0};
+  std::vector<int> owners; // a test may clear them
+
+ private:
+  Eigen::Index ghost_;
 };
 
 } // namespace
@@ -201,7 +209,7 @@ TEST(Pgs, PeriodicImagesAreOneBody)
   SpookParams params;
   params.h = 1e-2;
   ContactSystem sys(bodies, contacts, 3, params, 3);
-  RingExchange ring;
+  GhostOfBodyZero ring(3, {0, 1, 2, 0}); // bodies 0..2 owned, body 3 the image of body 0
   const Vector b = spook_rhs(sys);
   const Cones cones(sys);
   const std::vector<Vec6> scale = row_scales(sys);
@@ -238,26 +246,6 @@ TEST(Pgs, PeriodicImagesAreOneBody)
     }
 }
 
-namespace {
-
-// Two processes in one: body 1 is the other process's copy (a ghost) of body 0. forward copies
-// 0 to 1, reverse_sum adds 1 into 0; no local owners, so each copy relaxes apart within a sweep
-// as on two processes.
-class CopyExchange final : public Exchange {
- public:
-  void forward(Vector &v) const override { v.segment<6>(6) = v.segment<6>(0); }
-  void reverse_sum(Vector &v) const override
-  {
-    v.segment<6>(0) += v.segment<6>(6);
-    v.segment<6>(6).setZero();
-  }
-  void sum(double *, int) const override {}
-  void max(double *, int) const override {}
-  long exclusive_prefix_sum(long) const override { return 0; }
-};
-
-} // namespace
-
 // A sphere landing on a floor whose two halves meet under it, one contact on each process.
 // Each process alone stops the whole sphere, and together they overshoot: block Jacobi swings
 // between twice the needed impulse and none for ever. Split into two copies of half the mass,
@@ -285,7 +273,7 @@ TEST(Pgs, MassSplittingStopsSharedBodiesFromOvershooting)
   halves[1].a = 1;
   const ContactSystem split(two, halves, 3, params, 1);
   Vector lambda = Vector::Zero(split.contact_dofs());
-  const PgsResult res = pgs(split, CopyExchange(), Cones(split), spook_rhs(split),
+  const PgsResult res = pgs(split, GhostOfBodyZero(1, {}), Cones(split), spook_rhs(split),
                             row_scales(split), lambda, PgsControl{50, 1e-12, 50});
   EXPECT_EQ(res.reason, StopReason::converged);
   EXPECT_LE(res.sweeps, 3);
