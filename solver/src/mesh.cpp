@@ -149,7 +149,11 @@ void TriangleGrid::build(const std::vector<Triangle> &tris, double cell)
     box_hi_[t] = tri.p[0].cwiseMax(tri.p[1]).cwiseMax(tri.p[2]);
     lo = lo.cwiseMin(box_lo_[t]);
     hi = hi.cwiseMax(box_hi_[t]);
-    size_sum += (box_hi_[t] - box_lo_[t]).maxCoeff();
+    // the middle extent: a long thin facet (a silo's side) spans many cells instead of making
+    // every cell as long as itself
+    Vec3 extent = box_hi_[t] - box_lo_[t];
+    std::sort(extent.data(), extent.data() + 3);
+    size_sum += extent[1];
     ++finite;
   }
   items_.clear();
@@ -159,7 +163,8 @@ void TriangleGrid::build(const std::vector<Triangle> &tris, double cell)
   lo_ = lo;
   hi_ = hi;
 
-  // Cells about one triangle across keep both the lists and the cells scanned per query short.
+  // Cells about one triangle across (its middle extent) keep both the lists and the cells
+  // scanned per query short.
   if (!(cell > 0.0) || !std::isfinite(cell)) cell = size_sum / finite;
   if (!(cell > 0.0)) cell = (hi - lo).maxCoeff();
   if (!(cell > 0.0)) cell = 1.0; // all triangles are one point

@@ -47,7 +47,7 @@ Vec3 closest_point_on_triangle(const Vec3 &x, const Vec3 &a, const Vec3 &b, cons
 // per step). Each triangle is listed in every cell its box overlaps.
 class TriangleGrid {
  public:
-  // cell <= 0: the mean of the triangles' largest box extents. The cell grows until the grid
+  // cell <= 0: the mean of the triangles' middle box extents. The cell grows until the grid
   // has at most kMaxCells cells. Triangles with a non-finite node are left out.
   void build(const std::vector<Triangle> &tris, double cell);
   // The indices of the triangles whose bounding box, inflated by reach, contains x: each
