@@ -72,17 +72,23 @@ void FibreOutput::report_solve(const fibre::StepResult &res)
     ++nonconverged_since_warning_;
     const bigint step = update->ntimestep;
     if (last_warning_step_ < 0 || step - last_warning_step_ >= 100) {
-      if (comm->me == 0)
+      if (comm->me == 0) {
+        std::string why = std::string(fibre::to_string(res.reason)) + ", ";
+        if (res.total_iterations > 0) // a linear pass ran (a sweeps-only solve has none)
+          why += std::to_string(res.iterations) + " iterations, relative residual " +
+                 fibre::format_g(res.rel_residual) + ", ";
+        why += std::to_string(res.sweeps) + " sweeps, error estimate " +
+               fibre::format_g(res.error_estimate) + ", complementarity " +
+               fibre::format_g(res.complementarity);
         warn(error, FLERR,
              "Fix fibre_contact: contact solve did not converge at step " +
-                 std::to_string(static_cast<long long>(step)) + " (" +
-                 fibre::to_string(res.reason) + ", " + std::to_string(res.iterations) +
-                 " iterations, relative residual " + fibre::format_g(res.rel_residual) + ", " +
-                 std::to_string(res.sweeps) + " sweeps, complementarity " +
-                 fibre::format_g(res.complementarity) + "); " +
+                 std::to_string(static_cast<long long>(step)) + " (" + why +
+                 "); the step keeps these impulses; " +
                  std::to_string(static_cast<long long>(nonconverged_since_warning_)) +
                  " non-converged steps since the last warning, " +
-                 std::to_string(static_cast<long long>(nonconverged_total_)) + " in all");
+                 std::to_string(static_cast<long long>(nonconverged_total_)) +
+                 " in all (f_ID[12])");
+      }
       last_warning_step_ = step;
       nonconverged_since_warning_ = 0;
     }
