@@ -302,6 +302,40 @@ TEST(Mesh, GridCandidatesMatchBruteForce)
   EXPECT_TRUE(cand.empty());
 }
 
+// A silo's wall: 32 tall, narrow facets (a cylinder of radius 1 and height 10, 64 triangles).
+// The automatic cell follows a facet's middle extent (about its width, 0.2), not its length:
+// with cells as long as the facets every query scanned all 64 triangles. A sphere at the wall
+// still finds the facets within reach that brute force finds.
+TEST(Mesh, TallFacetsKeepTheGridsCellsSmall)
+{
+  const int n = 32;
+  const double pi = std::acos(-1.0), height = 10.0;
+  std::vector<Triangle> tris;
+  for (int k = 0; k < n; ++k) {
+    const double a0 = 2 * pi * k / n, a1 = 2 * pi * (k + 1) / n;
+    const Vec3 p0(std::cos(a0), std::sin(a0), 0), p1(std::cos(a1), std::sin(a1), 0);
+    const Vec3 up(0, 0, height);
+    tris.push_back(triangle(p0, p1, p1 + up, 2 * k));
+    tris.push_back(triangle(p0, p1 + up, p0 + up, 2 * k + 1));
+  }
+  TriangleGrid grid;
+  grid.build(tris, 0.0);
+  const double width = 2 * std::sin(pi / n); // a facet's chord, 0.196
+  EXPECT_GT(grid.cell(), 0.25 * width);
+  EXPECT_LT(grid.cell(), width);
+  std::vector<int> cand;
+  // About 0.07 inside the wall near the seam of facets 0 and 31 (the edge at angle 0). Within
+  // 0.1 (by hand): triangle 1, whose face lies under x (0.072); triangle 0, across facet 0's
+  // diagonal (0.088); triangle 62, through the edge (0.073). Triangle 63 meets that edge only
+  // at its top node.
+  const Vec3 x(0.93, 0.02, 4.0);
+  grid.candidates(x, 0.1, cand);
+  const std::vector<int> within = brute_force(tris, x, 0.1);
+  EXPECT_EQ(within, (std::vector<int>{0, 1, 62}));
+  for (int t : within) EXPECT_TRUE(std::binary_search(cand.begin(), cand.end(), t)) << t;
+  EXPECT_LE(cand.size(), 6u);
+}
+
 // A centre on the face: the geometric normal (p1 - p0) x (p2 - p0), so the winding decides.
 TEST(Mesh, CentreOnTheFaceTakesTheGeometricNormal)
 {
