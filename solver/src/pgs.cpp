@@ -224,6 +224,7 @@ class Anderson {
     count_ = 0;
     newest_ = -1;
     started_ = false;
+    combined_ = false;
   }
 
  private:
@@ -310,6 +311,11 @@ PgsResult pgs(const ContactSystem &sys, const Exchange &ex, const Cones &cones, 
   Vector lambda_start;
   double best = INFINITY;
   int since_best = 0;
+  // Anderson's combination can cycle where plain sweeps converge (a LIGGGHTS heap's step: its
+  // error grew again after sweep 900). After kAndersonStallSweeps sweeps without a new
+  // smallest change the sweeps go on plain from the best checkpointed sweep.
+  bool plain = false;
+  Vector lambda_best;
   Vector direction, change; // nonlinear CG
   double last_change2 = 0;
   std::unique_ptr<FibreBlocks> blocks;
@@ -343,7 +349,7 @@ PgsResult pgs(const ContactSystem &sys, const Exchange &ex, const Cones &cones, 
     double *changes = full && focus ? contact_changes.data() : nullptr;
     // Anderson: plain sweeps up to the floor (steps that it ends pay nothing), the history
     // from its last sweep on
-    const bool mixing = accelerate && s + 1 >= control.min_sweeps;
+    const bool mixing = accelerate && !plain && s + 1 >= control.min_sweeps;
     if (rows == 6)
       sweep<6>(sys, cones, b, inv_mass, inv_scale, ex.local_owners(), list, count, lambda, dv,
                norms, changes, mixing ? steps.data() : nullptr);
@@ -371,6 +377,8 @@ PgsResult pgs(const ContactSystem &sys, const Exchange &ex, const Cones &cones, 
       return res;
     }
     res.record(norms[1] > 0 ? std::sqrt(norms[0] / norms[1]) : 0.0, full);
+    // lambda is this sweep's result (feasible); a new smallest change is kept now and then
+    if (mixing && s % kCheckpointSweeps == 0 && res.last_change < best) lambda_best = lambda;
     if (mixing) {
       // A sweep that moved lambda more than the one before crossed a kink of the cones (the
       // sliding or open set changed): the old differences describe another map, and kept
@@ -402,7 +410,19 @@ PgsResult pgs(const ContactSystem &sys, const Exchange &ex, const Cones &cones, 
     if (res.last_change < best) {
       best = res.last_change;
       since_best = 0;
-    } else if (++since_best >= control.stall_sweeps) {
+    } else if (accelerate && !plain &&
+               ++since_best >= std::min(control.stall_sweeps, kAndersonStallSweeps)) {
+      plain = true;
+      anderson.restart();
+      res.restart_rate(); // the estimate follows the plain sweeps' own contraction
+      if (lambda_best.size()) {
+        lambda = lambda_best;
+        dv = velocity_change(sys, ex, lambda);
+      }
+      best = INFINITY;
+      since_best = 0;
+      ++res.fallbacks;
+    } else if ((!accelerate || plain) && ++since_best >= control.stall_sweeps) {
       res.reason = StopReason::stagnation;
       break;
     }

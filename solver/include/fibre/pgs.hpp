@@ -52,6 +52,9 @@ struct PgsControl {
 
 inline constexpr int kRateWindow = 5;
 inline constexpr double kAndersonSafety = 2.0;
+// Anderson's sweeps without a new smallest change after which the sweeps go on plain, from
+// the best checkpointed sweep (at most stall_sweeps).
+inline constexpr int kAndersonStallSweeps = 200;
 
 struct PgsResult {
   StopReason reason = StopReason::max_iterations;
@@ -70,11 +73,20 @@ struct PgsResult {
   // Jacobian) from the history, infinite without one; -1 without acceleration. The estimate
   // is then kAndersonSafety * last_change / singular_value.
   double singular_value = -1;
+  // Times Anderson's combination was given up for plain sweeps (kAndersonStallSweeps): 0 or 1.
+  int fallbacks = 0;
   std::vector<double> changes;  // per sweep (iteration)
   std::vector<int> full_sweeps; // the full sweeps' indices in `changes`
   // One more sweep's change: changes follows, and for a full sweep (every plain one)
   // last_change and contraction. A focused sweep's change leaves out the contacts it skips.
   void record(double change, bool full = true);
+  // Forget the rate: the sweeps from here on are another iteration (Anderson given up).
+  void restart_rate()
+  {
+    full_sweeps.clear();
+    contraction = 1;
+    singular_value = -1;
+  }
   double error_estimate() const;
   // The estimate when the accuracy rule was first met (infinite if never). The sweeps after it
   // (PgsControl::min_sweeps) only reduce the error, but their changes may fall to round-off,
