@@ -314,7 +314,7 @@ PgsResult pgs(const ContactSystem &sys, const Exchange &ex, const Cones &cones, 
   // Anderson's combination can cycle where plain sweeps converge (a LIGGGHTS heap's step: its
   // error grew again after sweep 900). After kAndersonStallSweeps sweeps without a new
   // smallest change the sweeps go on plain from the best checkpointed sweep.
-  bool plain = false;
+  bool plain = false, have_best = false; // have_best: alike on every process
   Vector lambda_best;
   Vector direction, change; // nonlinear CG
   double last_change2 = 0;
@@ -378,7 +378,10 @@ PgsResult pgs(const ContactSystem &sys, const Exchange &ex, const Cones &cones, 
     }
     res.record(norms[1] > 0 ? std::sqrt(norms[0] / norms[1]) : 0.0, full);
     // lambda is this sweep's result (feasible); a new smallest change is kept now and then
-    if (mixing && s % kCheckpointSweeps == 0 && res.last_change < best) lambda_best = lambda;
+    if (mixing && s % kCheckpointSweeps == 0 && res.last_change < best) {
+      lambda_best = lambda;
+      have_best = true;
+    }
     if (mixing) {
       // A sweep that moved lambda more than the one before crossed a kink of the cones (the
       // sliding or open set changed): the old differences describe another map, and kept
@@ -415,7 +418,7 @@ PgsResult pgs(const ContactSystem &sys, const Exchange &ex, const Cones &cones, 
       plain = true;
       anderson.restart();
       res.restart_rate(); // the estimate follows the plain sweeps' own contraction
-      if (lambda_best.size()) {
+      if (have_best) {    // a collective: every process, with or without contacts
         lambda = lambda_best;
         dv = velocity_change(sys, ex, lambda);
       }
