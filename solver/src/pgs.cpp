@@ -312,7 +312,7 @@ PgsResult pgs(const ContactSystem &sys, const Exchange &ex, const Cones &cones, 
   double best = INFINITY;
   int since_best = 0;
   // Anderson's combination can cycle where plain sweeps converge (a LIGGGHTS heap's step: its
-  // error grew again after sweep 900). After kAndersonStallSweeps sweeps without a new
+  // rotations drifted off again after sweep 900). After kAndersonStallSweeps sweeps without a new
   // smallest change the sweeps go on plain from the best checkpointed sweep.
   bool plain = false, have_best = false; // have_best: alike on every process
   Vector lambda_best;

@@ -236,7 +236,7 @@ TEST(AccuracyStudy, FloorOfSweepsBringsInTheRotationsOfAPileAtRest)
 // A step where Anderson's combination cycles and plain sweeps converge (the LIGGGHTS heap of
 // examples/liggghts/heap, step 374, feeding: 161 bodies, 48 contacts on and above the mesh
 // plate, exported under the default). The default without a way out left the rotations 197%
-// off after 1902 sweeps (its error was 3e-3 at sweep 900, then grew; "the run's own impulses"
+// off after 1902 sweeps (within 2.7e-3 at sweep 900, then drifting off; "the run's own impulses"
 // below). After kAndersonStallSweeps sweeps without a new smallest change the sweeps now go on
 // plain from the best checkpointed sweep, and converge (measured: 1448 sweeps, rotations
 // 8.8e-4, normal impulses 5.0e-5).
