@@ -410,11 +410,16 @@ PgsResult pgs(const ContactSystem &sys, const Exchange &ex, const Cones &cones, 
       res.reason = StopReason::converged;
       break;
     }
+    const bool anderson_on = accelerate && !plain;
     if (res.last_change < best) {
       best = res.last_change;
       since_best = 0;
-    } else if (accelerate && !plain &&
-               ++since_best >= std::min(control.stall_sweeps, kAndersonStallSweeps)) {
+    } else if (++since_best >= (anderson_on ? std::min(control.stall_sweeps, kAndersonStallSweeps)
+                                            : control.stall_sweeps)) {
+      if (!anderson_on) {
+        res.reason = StopReason::stagnation;
+        break;
+      }
       plain = true;
       anderson.restart();
       res.restart_rate(); // the estimate follows the plain sweeps' own contraction
@@ -424,10 +429,6 @@ PgsResult pgs(const ContactSystem &sys, const Exchange &ex, const Cones &cones, 
       }
       best = INFINITY;
       since_best = 0;
-      ++res.fallbacks;
-    } else if ((!accelerate || plain) && ++since_best >= control.stall_sweeps) {
-      res.reason = StopReason::stagnation;
-      break;
     }
     if (control.nonlinear_cg && s + 1 < control.max_sweeps) {
       change = lambda - lambda_start;

@@ -73,8 +73,6 @@ struct PgsResult {
   // Jacobian) from the history, infinite without one; -1 without acceleration. The estimate
   // is then kAndersonSafety * last_change / singular_value.
   double singular_value = -1;
-  // Times Anderson's combination was given up for plain sweeps (kAndersonStallSweeps): 0 or 1.
-  int fallbacks = 0;
   std::vector<double> changes;  // per sweep (iteration)
   std::vector<int> full_sweeps; // the full sweeps' indices in `changes`
   // One more sweep's change: changes follows, and for a full sweep (every plain one)
