@@ -2,18 +2,185 @@
 #include "lammps_exchange.h"
 
 #include <algorithm>
+#include <string>
 #include <unordered_map>
 
 #include "atom.h"
 #include "comm.h"
 #include "fix.h"
+#include "host.h"
 #include "lammps.h"
 
 namespace fibre_lmp {
 
+namespace {
+
+// The sweeps' halo (fibre::Exchange::Halo) by MPI point to point, on the bodies that contacts
+// move. LAMMPS's forward and reverse comms carry 6 values for every ghost atom through every
+// swap; a sweep on a stiff pile needs only the few dozen bodies that straddle a boundary, and
+// two LAMMPS comms a sweep cost as much as the sweep itself (bench/README.md, "The sweeps'
+// halo").
+class PointHalo final : public fibre::Exchange::Halo {
+ public:
+  struct Link {
+    int rank;
+    std::vector<int> bodies; // in the order of the ghosts' list on the ghosts' process
+  };
+  PointHalo(MPI_Comm comm, std::vector<Link> ghosts, std::vector<Link> shared,
+            std::vector<std::pair<int, int>> images)
+      : comm_(comm), ghosts_(std::move(ghosts)), shared_(std::move(shared)),
+        images_(std::move(images))
+  {
+  }
+
+  void sum_copies(fibre::Vector &v) const override
+  {
+    move(v, ghosts_, shared_, true, kChanges); // the ghosts' values into their owners
+    for (const auto &[image, body] : images_) v.segment<6>(6 * body) += v.segment<6>(6 * image);
+    move(v, shared_, ghosts_, false, kTotals); // the owners' sums back to the ghosts
+    for (const auto &[image, body] : images_) v.segment<6>(6 * image) = v.segment<6>(6 * body);
+  }
+
+ private:
+  static constexpr int kChanges = 1, kTotals = 2;
+
+  static std::size_t values(const std::vector<Link> &links)
+  {
+    std::size_t n = 0;
+    for (const Link &l : links) n += 6 * l.bodies.size();
+    return n;
+  }
+
+  // Sends the bodies of `from` to their links' processes and receives those of `to`, adding
+  // (in ascending rank order, so that a sum does not depend on the messages' arrival) or
+  // copying them into v.
+  void move(fibre::Vector &v, const std::vector<Link> &from, const std::vector<Link> &to, bool add,
+            int tag) const
+  {
+    in_.resize(values(to));
+    out_.resize(values(from));
+    requests_.clear();
+    std::size_t at = 0;
+    for (const Link &l : to) {
+      requests_.emplace_back();
+      MPI_Irecv(in_.data() + at, static_cast<int>(6 * l.bodies.size()), MPI_DOUBLE, l.rank, tag,
+                comm_, &requests_.back());
+      at += 6 * l.bodies.size();
+    }
+    at = 0;
+    for (const Link &l : from) {
+      const std::size_t first = at;
+      for (const int b : l.bodies)
+        for (int d = 0; d < 6; ++d) out_[at++] = v[6 * Eigen::Index(b) + d];
+      requests_.emplace_back();
+      MPI_Isend(out_.data() + first, static_cast<int>(at - first), MPI_DOUBLE, l.rank, tag, comm_,
+                &requests_.back());
+    }
+    MPI_Waitall(static_cast<int>(requests_.size()), requests_.data(), MPI_STATUSES_IGNORE);
+    at = 0;
+    for (const Link &l : to)
+      for (const int b : l.bodies)
+        for (int d = 0; d < 6; ++d, ++at) {
+          double &x = v[6 * Eigen::Index(b) + d];
+          x = add ? x + in_[at] : in_[at];
+        }
+  }
+
+  MPI_Comm comm_;
+  std::vector<Link> ghosts_; // per owner process, ascending: the touched ghosts it owns
+  std::vector<Link> shared_; // per process, ascending: the owned bodies it touches as ghosts
+  std::vector<std::pair<int, int>> images_; // touched periodic images here, and their bodies
+  mutable std::vector<double> in_, out_;
+  mutable std::vector<MPI_Request> requests_;
+};
+
+} // namespace
+
 LammpsExchange::LammpsExchange(LAMMPS_NS::LAMMPS *lmp, LAMMPS_NS::Fix *fix, MPI_Comm world)
     : lmp_(lmp), fix_(fix), world_(world)
 {
+  MPI_Comm_dup(world, &halo_comm_);
+}
+
+LammpsExchange::~LammpsExchange()
+{
+  if (halo_comm_ != MPI_COMM_NULL) MPI_Comm_free(&halo_comm_);
+}
+
+const std::vector<int> &LammpsExchange::ghost_owners() const
+{
+  if (ghost_owners_known_) return ghost_owners_;
+  resize_halo();
+  const int nlocal = lmp_->atom->nlocal;
+  for (int i = 0; i < nlocal; ++i) halo_[std::size_t(kValuesPerAtom) * i] = lmp_->comm->me;
+  fibre_forward_comm(lmp_->comm, fix_, kValuesPerAtom);
+  ghost_owners_.assign(body_atom_.size(), -1);
+  for (std::size_t k = num_owned_; k < body_atom_.size(); ++k)
+    ghost_owners_[k] = static_cast<int>(halo_[std::size_t(kValuesPerAtom) * body_atom_[k]]);
+  ghost_owners_known_ = true;
+  return ghost_owners_;
+}
+
+std::unique_ptr<fibre::Exchange::Halo> LammpsExchange::halo(const std::vector<char> &touched) const
+{
+  using Link = PointHalo::Link;
+  const int nprocs = lmp_->comm->nprocs, me = lmp_->comm->me;
+  const int nbody = static_cast<int>(body_atom_.size());
+  std::vector<std::pair<int, int>> images;
+  for (int k = num_owned_; k < nbody; ++k)
+    if (touched[k] && local_owners_[k] != k) images.emplace_back(k, local_owners_[k]);
+  if (nprocs == 1)
+    return std::make_unique<PointHalo>(halo_comm_, std::vector<Link>(), std::vector<Link>(),
+                                       std::move(images));
+
+  // the touched ghosts by owner, and to each owner their tags
+  const std::vector<int> &owner = ghost_owners();
+  std::vector<std::vector<int>> ghosts_of(nprocs);
+  for (int k = num_owned_; k < nbody; ++k)
+    if (touched[k] && local_owners_[k] == k) ghosts_of[owner[k]].push_back(k);
+  std::vector<int> send_count(nprocs), recv_count(nprocs);
+  for (int r = 0; r < nprocs; ++r) send_count[r] = static_cast<int>(ghosts_of[r].size());
+  MPI_Alltoall(send_count.data(), 1, MPI_INT, recv_count.data(), 1, MPI_INT, halo_comm_);
+  const LAMMPS_NS::tagint *tag = lmp_->atom->tag;
+  std::vector<std::vector<double>> tags_out(nprocs), tags_in(nprocs);
+  std::vector<MPI_Request> requests;
+  for (int r = 0; r < nprocs; ++r)
+    if (recv_count[r] > 0) {
+      tags_in[r].resize(recv_count[r]);
+      requests.emplace_back();
+      MPI_Irecv(tags_in[r].data(), recv_count[r], MPI_DOUBLE, r, 0, halo_comm_, &requests.back());
+    }
+  for (int r = 0; r < nprocs; ++r)
+    if (send_count[r] > 0) {
+      for (const int k : ghosts_of[r])
+        tags_out[r].push_back(static_cast<double>(tag[body_atom_[k]]));
+      requests.emplace_back();
+      MPI_Isend(tags_out[r].data(), send_count[r], MPI_DOUBLE, r, 0, halo_comm_, &requests.back());
+    }
+  MPI_Waitall(static_cast<int>(requests.size()), requests.data(), MPI_STATUSES_IGNORE);
+
+  std::vector<Link> ghosts, shared;
+  for (int r = 0; r < nprocs; ++r)
+    if (send_count[r] > 0) ghosts.push_back({r, std::move(ghosts_of[r])});
+  std::unordered_map<LAMMPS_NS::tagint, int> owned;
+  for (int k = 0; k < num_owned_; ++k) owned.emplace(tag[body_atom_[k]], k);
+  for (int r = 0; r < nprocs; ++r) {
+    if (recv_count[r] == 0) continue;
+    Link link{r, {}};
+    for (const double t : tags_in[r]) {
+      const auto it = owned.find(static_cast<LAMMPS_NS::tagint>(t));
+      if (it == owned.end()) {
+        const std::string msg = "fix fibre_contact: process " + std::to_string(r) +
+                                " holds a ghost of atom " + std::to_string(long(t)) +
+                                ", which process " + std::to_string(me) + " does not own";
+        fail_one(lmp_->error, FLERR, msg);
+      }
+      link.bodies.push_back(it->second);
+    }
+    shared.push_back(std::move(link));
+  }
+  return std::make_unique<PointHalo>(halo_comm_, std::move(ghosts), std::move(shared),
+                                     std::move(images));
 }
 
 void LammpsExchange::set_bodies(const std::vector<int> &body_atom, int num_owned)
@@ -30,6 +197,7 @@ void LammpsExchange::set_bodies(const std::vector<int> &body_atom, int num_owned
     local_owners_[k] = it == owned.end() ? k : it->second;
   }
   has_halo_ = lmp_->comm->nprocs > 1 || body_atom.size() > std::size_t(num_owned);
+  ghost_owners_known_ = false;
 }
 
 void LammpsExchange::resize_halo() const

@@ -25,6 +25,9 @@ class LammpsExchange final : public fibre::Exchange {
   static constexpr int kValuesPerAtom = 6;
 
   LammpsExchange(LAMMPS_NS::LAMMPS *lmp, LAMMPS_NS::Fix *fix, MPI_Comm world);
+  ~LammpsExchange() override;
+  LammpsExchange(const LammpsExchange &) = delete;
+  LammpsExchange &operator=(const LammpsExchange &) = delete;
 
   // Body k <-> local atom body_atom[k]; bodies [0, num_owned) are owned atoms (< nlocal).
   void set_bodies(const std::vector<int> &body_atom, int num_owned);
@@ -37,6 +40,8 @@ class LammpsExchange final : public fibre::Exchange {
   void sum(double *values, int n) const override;
   void max(double *values, int n) const override;
   long exclusive_prefix_sum(long local) const override;
+  // Point to point between the processes that share the touched bodies (lammps_exchange.cpp).
+  std::unique_ptr<Halo> halo(const std::vector<char> &touched) const override;
   const std::vector<int> &local_owners() const override { return local_owners_; }
   using fibre::Exchange::max;
   using fibre::Exchange::sum;
@@ -49,15 +54,21 @@ class LammpsExchange final : public fibre::Exchange {
 
  private:
   void resize_halo() const;
+  // The owner process of every ghost body (-1 for owned ones), by a forward comm once per set
+  // of bodies.
+  const std::vector<int> &ghost_owners() const;
 
   LAMMPS_NS::LAMMPS *lmp_;
   LAMMPS_NS::Fix *fix_;
   MPI_Comm world_;
   std::vector<int> body_atom_;
   int num_owned_ = 0;
-  std::vector<int> local_owners_;    // periodic images of owned bodies -> those bodies
-  bool has_halo_ = true;             // other processes, or ghost bodies here
-  mutable std::vector<double> halo_; // 6 per local atom (owned + ghost)
+  std::vector<int> local_owners_; // periodic images of owned bodies -> those bodies
+  mutable std::vector<int> ghost_owners_;
+  mutable bool ghost_owners_known_ = false;
+  MPI_Comm halo_comm_ = MPI_COMM_NULL; // the sweeps' messages, apart from LAMMPS's
+  bool has_halo_ = true;               // other processes, or ghost bodies here
+  mutable std::vector<double> halo_;   // 6 per local atom (owned + ghost)
 };
 
 } // namespace fibre_lmp

@@ -31,6 +31,28 @@ void ImageExchange::reverse_sum(Vector &body_vec) const
     }
 }
 
+namespace {
+
+class FullHalo final : public Exchange::Halo {
+ public:
+  explicit FullHalo(const Exchange &ex) : ex_(ex) {}
+  void sum_copies(Vector &body_vec) const override
+  {
+    ex_.reverse_sum(body_vec);
+    ex_.forward(body_vec);
+  }
+
+ private:
+  const Exchange &ex_;
+};
+
+} // namespace
+
+std::unique_ptr<Exchange::Halo> Exchange::halo(const std::vector<char> &) const
+{
+  return std::make_unique<FullHalo>(*this);
+}
+
 const Exchange &serial_exchange()
 {
   static const SerialExchange ex;

@@ -299,6 +299,16 @@ PgsResult pgs(const ContactSystem &sys, const Exchange &ex, const Cones &cones, 
     for (std::size_t c = 0; c < scale.size(); ++c) inv_scale[c] = scale[c].cwiseInverse();
   }
   const double *inv_mass = split.size() ? split_inv_mass.data() : sys.inv_mass().data();
+  // the bodies whose velocities this process's sweeps change (an image's is its body's)
+  std::unique_ptr<Exchange::Halo> copies;
+  if (halo) {
+    std::vector<char> touched(sys.num_bodies(), 0);
+    const std::vector<int> &owners = ex.local_owners();
+    const int *pairs = sys.body_pairs();
+    for (int e = 0; e < 2 * nc; ++e)
+      if (pairs[e] >= 0) touched[owners.empty() ? pairs[e] : owners[pairs[e]]] = 1;
+    copies = ex.halo(touched);
+  }
   // the blocks read their bound rows from feasible impulses
   if (control.fibre_blocks)
     for (int c = 0; c < nc; ++c) cones.project(lambda.data() + Eigen::Index(rows) * c, c);
@@ -363,8 +373,7 @@ PgsResult pgs(const ContactSystem &sys, const Exchange &ex, const Cones &cones, 
     if (halo) {
       moved = dv - dv_start;
       if (split.size()) moved.array() /= split.array();
-      ex.reverse_sum(moved);
-      ex.forward(moved);
+      copies->sum_copies(moved);
       dv = dv_start + moved;
     }
     ex.sum(norms, 2);

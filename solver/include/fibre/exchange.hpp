@@ -5,6 +5,7 @@
 // use SerialExchange.
 #pragma once
 
+#include <memory>
 #include <utility>
 #include <vector>
 
@@ -24,6 +25,20 @@ class Exchange {
   virtual bool has_halo() const { return true; }
   // Global sum over all processes, in place.
   virtual void sum(double *values, int n) const = 0;
+
+  // The copies of the bodies that contacts move, for solvers that exchange per-body changes
+  // many times over one fixed set of contacts (the sweeps: once per sweep).
+  class Halo {
+   public:
+    virtual ~Halo() = default;
+    // Every copy of a body that some process touches gets the sum of all its copies' values:
+    // reverse_sum, then forward, on those bodies only. Copies that no process touches, and
+    // ghosts that this process does not touch, keep their values.
+    virtual void sum_copies(Vector &body_vec) const = 0;
+  };
+  // touched: one flag per local body (owned, then ghosts), set where this process's contacts
+  // move it. A collective. The default sums every body's copies.
+  virtual std::unique_ptr<Halo> halo(const std::vector<char> &touched) const;
   // Global maximum over all processes, in place.
   virtual void max(double *values, int n) const = 0;
 
