@@ -25,6 +25,19 @@ class Exchange {
   virtual bool has_halo() const { return true; }
   // Global sum over all processes, in place.
   virtual void sum(double *values, int n) const = 0;
+  // Global maximum over all processes, in place.
+  virtual void max(double *values, int n) const = 0;
+
+  // Exclusive prefix sum over processes in rank order (0 on the first).
+  virtual long exclusive_prefix_sum(long local) const = 0;
+  // For every local body, the body of this process that holds its velocity: itself, or for a
+  // ghost that is a periodic image of a body owned here, that body. Gauss-Seidel sweeps update
+  // it in place (the images of one body must not relax apart within a sweep). Empty: itself.
+  virtual const std::vector<int> &local_owners() const
+  {
+    static const std::vector<int> none;
+    return none;
+  }
 
   // The copies of the bodies that contacts move, for solvers that exchange per-body changes
   // many times over one fixed set of contacts (the sweeps: once per sweep).
@@ -39,19 +52,6 @@ class Exchange {
   // touched: one flag per local body (owned, then ghosts), set where this process's contacts
   // move it. A collective. The default sums every body's copies.
   virtual std::unique_ptr<Halo> halo(const std::vector<char> &touched) const;
-  // Global maximum over all processes, in place.
-  virtual void max(double *values, int n) const = 0;
-
-  // Exclusive prefix sum over processes in rank order (0 on the first).
-  virtual long exclusive_prefix_sum(long local) const = 0;
-  // For every local body, the body of this process that holds its velocity: itself, or for a
-  // ghost that is a periodic image of a body owned here, that body. Gauss-Seidel sweeps update
-  // it in place (the images of one body must not relax apart within a sweep). Empty: itself.
-  virtual const std::vector<int> &local_owners() const
-  {
-    static const std::vector<int> none;
-    return none;
-  }
 
   double sum(double x) const
   {
