@@ -162,14 +162,12 @@ std::unique_ptr<fibre::Exchange::Halo> LammpsExchange::halo(const std::vector<ch
   std::vector<Link> ghosts, shared;
   for (int r = 0; r < nprocs; ++r)
     if (send_count[r] > 0) ghosts.push_back({r, std::move(ghosts_of[r])});
-  std::unordered_map<LAMMPS_NS::tagint, int> owned;
-  for (int k = 0; k < num_owned_; ++k) owned.emplace(tag[body_atom_[k]], k);
   for (int r = 0; r < nprocs; ++r) {
     if (recv_count[r] == 0) continue;
     Link link{r, {}};
     for (const double t : tags_in[r]) {
-      const auto it = owned.find(static_cast<LAMMPS_NS::tagint>(t));
-      if (it == owned.end()) {
+      const auto it = owned_body_.find(static_cast<LAMMPS_NS::tagint>(t));
+      if (it == owned_body_.end()) {
         const std::string msg = "fix fibre_contact: process " + std::to_string(r) +
                                 " holds a ghost of atom " + std::to_string(long(t)) +
                                 ", which process " + std::to_string(me) + " does not own";
@@ -189,12 +187,12 @@ void LammpsExchange::set_bodies(const std::vector<int> &body_atom, int num_owned
   num_owned_ = num_owned;
   // a ghost with the tag of an owned body is its periodic image on this process
   const LAMMPS_NS::tagint *tag = lmp_->atom->tag;
-  std::unordered_map<LAMMPS_NS::tagint, int> owned;
-  for (int k = 0; k < num_owned; ++k) owned.emplace(tag[body_atom[k]], k);
+  owned_body_.clear();
+  for (int k = 0; k < num_owned; ++k) owned_body_.emplace(tag[body_atom[k]], k);
   local_owners_.resize(body_atom.size());
   for (int k = 0; k < static_cast<int>(body_atom.size()); ++k) {
-    const auto it = k < num_owned ? owned.end() : owned.find(tag[body_atom[k]]);
-    local_owners_[k] = it == owned.end() ? k : it->second;
+    const auto it = k < num_owned ? owned_body_.end() : owned_body_.find(tag[body_atom[k]]);
+    local_owners_[k] = it == owned_body_.end() ? k : it->second;
   }
   has_halo_ = lmp_->comm->nprocs > 1 || body_atom.size() > std::size_t(num_owned);
   ghost_owners_known_ = false;

@@ -9,9 +9,11 @@
 
 #include <mpi.h>
 
+#include <unordered_map>
 #include <vector>
 
 #include "fibre/exchange.hpp"
+#include "lmptype.h"
 
 namespace LAMMPS_NS {
 class LAMMPS;
@@ -64,6 +66,7 @@ class LammpsExchange final : public fibre::Exchange {
   std::vector<int> body_atom_;
   int num_owned_ = 0;
   std::vector<int> local_owners_; // periodic images of owned bodies -> those bodies
+  std::unordered_map<LAMMPS_NS::tagint, int> owned_body_; // an owned body's tag -> its index
   mutable std::vector<int> ghost_owners_;
   mutable bool ghost_owners_known_ = false;
   MPI_Comm halo_comm_ = MPI_COMM_NULL; // the sweeps' messages, apart from LAMMPS's

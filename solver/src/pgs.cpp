@@ -101,20 +101,24 @@ void sweep(const ContactSystem &sys, const Cones &cones, const Vector &b, const 
   }
 }
 
-// Mass splitting (pgs.hpp): per body, 6 entries each, the number of processes whose contacts
-// move it (at least 1), on its owner and its ghosts. Empty where no body is shared.
-Vector body_splits(const ContactSystem &sys, const Exchange &ex)
+// Per local body, whether this process's contacts move it (an image's velocity is its body's).
+std::vector<char> touched_bodies(const ContactSystem &sys, const Exchange &ex)
 {
   const std::vector<int> &owners = ex.local_owners();
   const int *pairs = sys.body_pairs();
-  Vector split = Vector::Zero(sys.body_dofs());
-  for (int c = 0; c < sys.num_contacts(); ++c)
-    for (int side = 0; side < 2; ++side) {
-      int body = pairs[2 * std::size_t(c) + side];
-      if (body < 0) continue;
-      if (!owners.empty()) body = owners[body];
-      split.segment<kBodyDofs>(Eigen::Index(kBodyDofs) * body).setOnes();
-    }
+  std::vector<char> touched(sys.num_bodies(), 0);
+  for (int e = 0; e < 2 * sys.num_contacts(); ++e)
+    if (pairs[e] >= 0) touched[owners.empty() ? pairs[e] : owners[pairs[e]]] = 1;
+  return touched;
+}
+
+// Mass splitting (pgs.hpp): per body, 6 entries each, the number of processes whose contacts
+// move it (at least 1), on its owner and its ghosts. Empty where no body is shared.
+Vector body_splits(const std::vector<char> &touched, const Exchange &ex)
+{
+  Vector split = Vector::Zero(Eigen::Index(kBodyDofs) * Eigen::Index(touched.size()));
+  for (std::size_t body = 0; body < touched.size(); ++body)
+    if (touched[body]) split.segment<kBodyDofs>(Eigen::Index(kBodyDofs) * body).setOnes();
   ex.reverse_sum(split);
   ex.forward(split);
   split = split.cwiseMax(1.0);
@@ -277,8 +281,9 @@ PgsResult pgs(const ContactSystem &sys, const Exchange &ex, const Cones &cones, 
   // CG, whose steps along its direction it slowed (12 of test_fix_solvers' 60 steps at np 2
   // unconverged).
   const bool halo = ex.has_halo(); // else the round trip below is the identity
+  const std::vector<char> touched = halo ? touched_bodies(sys, ex) : std::vector<char>();
   const Vector split =
-      halo && !control.fibre_blocks && !control.nonlinear_cg ? body_splits(sys, ex) : Vector();
+      halo && !control.fibre_blocks && !control.nonlinear_cg ? body_splits(touched, ex) : Vector();
   Vector split_inv_mass;
   std::vector<Vec6> inv_scale(scale.size());
   if (split.size()) {
@@ -299,16 +304,7 @@ PgsResult pgs(const ContactSystem &sys, const Exchange &ex, const Cones &cones, 
     for (std::size_t c = 0; c < scale.size(); ++c) inv_scale[c] = scale[c].cwiseInverse();
   }
   const double *inv_mass = split.size() ? split_inv_mass.data() : sys.inv_mass().data();
-  // the bodies whose velocities this process's sweeps change (an image's is its body's)
-  std::unique_ptr<Exchange::Halo> copies;
-  if (halo) {
-    std::vector<char> touched(sys.num_bodies(), 0);
-    const std::vector<int> &owners = ex.local_owners();
-    const int *pairs = sys.body_pairs();
-    for (int e = 0; e < 2 * nc; ++e)
-      if (pairs[e] >= 0) touched[owners.empty() ? pairs[e] : owners[pairs[e]]] = 1;
-    copies = ex.halo(touched);
-  }
+  const std::unique_ptr<Exchange::Halo> copies = halo ? ex.halo(touched) : nullptr;
   // the blocks read their bound rows from feasible impulses
   if (control.fibre_blocks)
     for (int c = 0; c < nc; ++c) cones.project(lambda.data() + Eigen::Index(rows) * c, c);
