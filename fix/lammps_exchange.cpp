@@ -27,11 +27,13 @@ class PointHalo final : public fibre::Exchange::Halo {
     std::vector<int> bodies; // in the order of the ghosts' list on the ghosts' process
   };
   PointHalo(MPI_Comm comm, std::vector<Link> ghosts, std::vector<Link> shared,
-            std::vector<std::pair<int, int>> images)
+            std::vector<std::pair<int, int>> images, int colours = 1, int colour = 0)
       : comm_(comm), ghosts_(std::move(ghosts)), shared_(std::move(shared)),
-        images_(std::move(images))
+        images_(std::move(images)), colours_(colours), colour_(colour)
   {
   }
+  int colours() const override { return colours_; }
+  int colour() const override { return colour_; }
 
   void sum_copies(fibre::Vector &v) const override
   {
@@ -90,9 +92,38 @@ class PointHalo final : public fibre::Exchange::Halo {
   std::vector<Link> ghosts_; // per owner process, ascending: the touched ghosts it owns
   std::vector<Link> shared_; // per process, ascending: the owned bodies it touches as ghosts
   std::vector<std::pair<int, int>> images_; // touched periodic images here, and their bodies
+  int colours_, colour_;
   mutable std::vector<double> in_, out_;
   mutable std::vector<MPI_Request> requests_;
 };
+
+// Greedy colouring of the processes, the same on every one: each owner lists the pairs of
+// processes that touch one of its bodies, all lists are gathered, and each process in rank
+// order takes the smallest colour that none of its neighbours of lower rank holds.
+std::pair<int, int> colour_processes(MPI_Comm comm, int nprocs, int me,
+                                     const std::vector<int> &local_edges)
+{
+  const int n_local = static_cast<int>(local_edges.size());
+  std::vector<int> counts(nprocs), displs(nprocs, 0);
+  MPI_Allgather(&n_local, 1, MPI_INT, counts.data(), 1, MPI_INT, comm);
+  for (int r = 1; r < nprocs; ++r) displs[r] = displs[r - 1] + counts[r - 1];
+  std::vector<int> edges(std::size_t(displs[nprocs - 1] + counts[nprocs - 1]));
+  MPI_Allgatherv(local_edges.data(), n_local, MPI_INT, edges.data(), counts.data(), displs.data(),
+                 MPI_INT, comm);
+  std::vector<std::vector<int>> lower(nprocs); // each process's neighbours of lower rank
+  for (std::size_t e = 0; e + 1 < edges.size(); e += 2)
+    lower[std::max(edges[e], edges[e + 1])].push_back(std::min(edges[e], edges[e + 1]));
+  std::vector<int> colour(nprocs, 0);
+  int colours = 1;
+  for (int r = 0; r < nprocs; ++r) {
+    std::vector<char> taken(lower[r].size() + 1, 0);
+    for (const int q : lower[r])
+      if (colour[q] < static_cast<int>(taken.size())) taken[colour[q]] = 1;
+    while (taken[colour[r]]) ++colour[r];
+    colours = std::max(colours, colour[r] + 1);
+  }
+  return {colours, colour[me]};
+}
 
 } // namespace
 
@@ -177,8 +208,34 @@ std::unique_ptr<fibre::Exchange::Halo> LammpsExchange::halo(const std::vector<ch
     }
     shared.push_back(std::move(link));
   }
+  // the pairs of processes that touch a body owned here (this one too where it touches it)
+  std::vector<std::vector<int>> touching(num_owned_);
+  for (int k = 0; k < num_owned_; ++k)
+    if (touched[k]) touching[k].push_back(me);
+  for (int k = num_owned_; k < nbody; ++k) // periodic images touched here: their bodies
+    if (touched[k] && local_owners_[k] != k &&
+        (touching[local_owners_[k]].empty() || touching[local_owners_[k]].back() != me))
+      touching[local_owners_[k]].push_back(me);
+  for (const Link &l : shared)
+    for (const int k : l.bodies)
+      if (touching[k].empty() || touching[k].back() != l.rank) touching[k].push_back(l.rank);
+  std::vector<int> edges;
+  for (const std::vector<int> &ranks : touching)
+    for (std::size_t i = 0; i < ranks.size(); ++i)
+      for (std::size_t j = i + 1; j < ranks.size(); ++j) {
+        edges.push_back(std::min(ranks[i], ranks[j]));
+        edges.push_back(std::max(ranks[i], ranks[j]));
+      }
+  // duplicates cost only the gather
+  std::vector<std::pair<int, int>> pairs;
+  for (std::size_t e = 0; e < edges.size(); e += 2) pairs.emplace_back(edges[e], edges[e + 1]);
+  std::sort(pairs.begin(), pairs.end());
+  pairs.erase(std::unique(pairs.begin(), pairs.end()), pairs.end());
+  edges.clear();
+  for (const auto &[a, b] : pairs) edges.push_back(a), edges.push_back(b);
+  const auto [colours, colour] = colour_processes(halo_comm_, nprocs, me, edges);
   return std::make_unique<PointHalo>(halo_comm_, std::move(ghosts), std::move(shared),
-                                     std::move(images));
+                                     std::move(images), colours, colour);
 }
 
 void LammpsExchange::set_bodies(const std::vector<int> &body_atom, int num_owned)

@@ -269,6 +269,35 @@ class Anderson {
   Vector rhs_ = Vector::Zero(memory_);
 };
 
+// The contacts of each colour's phase (colours > 1), in their order: those on a body that
+// other processes' contacts move too (shares > 1) in this process's phase, the others dealt out
+// evenly over all phases, so that every process sweeps about as many in each.
+std::vector<std::vector<int>> colour_phases(const ContactSystem &sys, const Exchange &ex,
+                                            const Vector &shares, int colours, int colour)
+{
+  const std::vector<int> &owners = ex.local_owners();
+  const auto shared = [&](int body) {
+    return body >= 0 &&
+           shares[Eigen::Index(kBodyDofs) * (owners.empty() ? body : owners[body])] > 1.0;
+  };
+  const int nc = sys.num_contacts();
+  std::vector<char> boundary(nc);
+  int inner = 0;
+  for (int c = 0; c < nc; ++c) {
+    const Contact &k = sys.contacts()[c];
+    boundary[c] = shared(k.a) || shared(k.b);
+    inner += !boundary[c];
+  }
+  std::vector<std::vector<int>> phases(colours);
+  int seen = 0;
+  for (int c = 0; c < nc; ++c)
+    if (boundary[c])
+      phases[colour].push_back(c);
+    else
+      phases[std::size_t(long(seen++) * colours / std::max(inner, 1))].push_back(c);
+  return phases;
+}
+
 } // namespace
 
 PgsResult pgs(const ContactSystem &sys, const Exchange &ex, const Cones &cones, const Vector &b,
@@ -276,14 +305,28 @@ PgsResult pgs(const ContactSystem &sys, const Exchange &ex, const Cones &cones, 
 {
   PgsResult res;
   const int nc = sys.num_contacts(), rows = sys.rows();
+  const bool halo = ex.has_halo(); // else the round trip below is the identity
+  const std::vector<char> touched = halo ? touched_bodies(sys, ex) : std::vector<char>();
+  const std::unique_ptr<Exchange::Halo> copies = halo ? ex.halo(touched) : nullptr;
+  // the blocks' corrections are not part of the sweeps' steps, and measured with them the
+  // combination diverged on a stiff pile: plain sweeps only
+  const bool accelerate = control.anderson > 0 && !control.nonlinear_cg && !control.fibre_blocks;
+  const bool focus =
+      control.focus_sweeps > 0 && !control.nonlinear_cg && !control.fibre_blocks && !accelerate;
   // Mass splitting: the sweeps see a shared body's copy, of inverse mass split / m. Not with
   // fibre blocks, whose corrections move their bodies at their own mass, nor with nonlinear
   // CG, whose steps along its direction it slowed (12 of test_fix_solvers' 60 steps at np 2
   // unconverged).
-  const bool halo = ex.has_halo(); // else the round trip below is the identity
-  const std::vector<char> touched = halo ? touched_bodies(sys, ex) : std::vector<char>();
-  const Vector split =
+  const Vector shares =
       halo && !control.fibre_blocks && !control.nonlinear_cg ? body_splits(touched, ex) : Vector();
+  // Process colours (Exchange::Halo::colours): the contacts on shared bodies are swept one
+  // colour at a time, so that a shared body moves at its own mass as on one process; with more
+  // colours than kMaxColours, or focused sweeps, its mass is split instead.
+  const int colours = shares.size() && !focus ? copies->colours() : 1;
+  const bool coloured = colours > 1 && colours <= kMaxColours;
+  const Vector split = coloured ? Vector() : shares;
+  std::vector<std::vector<int>> phases;
+  if (coloured) phases = colour_phases(sys, ex, shares, colours, copies->colour());
   Vector split_inv_mass;
   std::vector<Vec6> inv_scale(scale.size());
   if (split.size()) {
@@ -304,7 +347,6 @@ PgsResult pgs(const ContactSystem &sys, const Exchange &ex, const Cones &cones, 
     for (std::size_t c = 0; c < scale.size(); ++c) inv_scale[c] = scale[c].cwiseInverse();
   }
   const double *inv_mass = split.size() ? split_inv_mass.data() : sys.inv_mass().data();
-  const std::unique_ptr<Exchange::Halo> copies = halo ? ex.halo(touched) : nullptr;
   // the blocks read their bound rows from feasible impulses
   if (control.fibre_blocks)
     for (int c = 0; c < nc; ++c) cones.project(lambda.data() + Eigen::Index(rows) * c, c);
@@ -331,10 +373,6 @@ PgsResult pgs(const ContactSystem &sys, const Exchange &ex, const Cones &cones, 
     blocks =
         std::make_unique<FibreBlocks>(sys, ex.local_owners(), cones, control.block_weight, &normal);
   }
-  // the blocks' corrections are not part of the sweeps' steps, and measured with them the
-  // combination diverged on a stiff pile: plain sweeps only
-  const bool accelerate = control.anderson > 0 && !control.nonlinear_cg && !blocks;
-  const bool focus = control.focus_sweeps > 0 && !control.nonlinear_cg && !blocks && !accelerate;
   Anderson anderson(std::max(control.anderson, 1), ex);
   Vector steps(accelerate ? lambda.size() : 0);
   std::vector<double> contact_changes(focus ? nc : 0);
@@ -356,22 +394,32 @@ PgsResult pgs(const ContactSystem &sys, const Exchange &ex, const Cones &cones, 
     // Anderson: plain sweeps up to the floor (steps that it ends pay nothing), the history
     // from its last sweep on
     const bool mixing = accelerate && !plain && s + 1 >= control.min_sweeps;
-    if (rows == 6)
-      sweep<6>(sys, cones, b, inv_mass, inv_scale, ex.local_owners(), list, count, lambda, dv,
-               norms, changes, mixing ? steps.data() : nullptr);
-    else
-      sweep<3>(sys, cones, b, inv_mass, inv_scale, ex.local_owners(), list, count, lambda, dv,
-               norms, changes, mixing ? steps.data() : nullptr);
+    // Every process's updates on every body: the sum of the local changes, owners and ghosts
+    // (each copy's change at the body's own mass); with colours after each colour's phase.
+    const auto sweep_and_sum = [&](const int *visit, int n) {
+      if (rows == 6)
+        sweep<6>(sys, cones, b, inv_mass, inv_scale, ex.local_owners(), visit, n, lambda, dv, norms,
+                 changes, mixing ? steps.data() : nullptr);
+      else
+        sweep<3>(sys, cones, b, inv_mass, inv_scale, ex.local_owners(), visit, n, lambda, dv, norms,
+                 changes, mixing ? steps.data() : nullptr);
+      if (halo) {
+        moved = dv - dv_start;
+        if (split.size()) moved.array() /= split.array();
+        copies->sum_copies(moved);
+        dv = dv_start + moved;
+      }
+    };
+    if (coloured) {
+      for (const std::vector<int> &phase : phases) {
+        dv_start = dv;
+        sweep_and_sum(phase.data(), static_cast<int>(phase.size()));
+      }
+    } else {
+      sweep_and_sum(list, count);
+    }
     if (changes) focus_list(contact_changes, norms[0], focus_contacts);
     res.visits += count;
-    // Every process's updates on every body: the sum of the local changes, owners and ghosts
-    // (each copy's change at the body's own mass).
-    if (halo) {
-      moved = dv - dv_start;
-      if (split.size()) moved.array() /= split.array();
-      copies->sum_copies(moved);
-      dv = dv_start + moved;
-    }
     ex.sum(norms, 2);
     ++res.sweeps;
     if (!std::isfinite(norms[0]) || !std::isfinite(norms[1])) {

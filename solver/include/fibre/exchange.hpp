@@ -48,6 +48,11 @@ class Exchange {
     // reverse_sum, then forward, on those bodies only. Copies that no process touches, and
     // ghosts that this process does not touch, keep their values.
     virtual void sum_copies(Vector &body_vec) const = 0;
+    // A colouring of the processes in which two that touch a common body differ: the sweeps
+    // can then visit the contacts on shared bodies one colour at a time, as one process would
+    // (pgs.cpp). One colour: no colouring (the sweeps split the shared bodies' masses).
+    virtual int colours() const { return 1; }
+    virtual int colour() const { return 0; }
   };
   // touched: one flag per local body (owned, then ghosts), set where this process's contacts
   // move it. A collective. The default sums every body's copies.
