@@ -2,6 +2,7 @@
 #include "lammps_exchange.h"
 
 #include <algorithm>
+#include <map>
 #include <string>
 #include <unordered_map>
 
@@ -97,9 +98,12 @@ class PointHalo final : public fibre::Exchange::Halo {
   mutable std::vector<MPI_Request> requests_;
 };
 
-// Greedy colouring of the processes, the same on every one: each owner lists the pairs of
-// processes that touch one of its bodies, all lists are gathered, and each process in rank
-// order takes the smallest colour that none of its neighbours of lower rank holds.
+// Two colours for the processes (Exchange::Halo::colours), the same on every one: each owner
+// lists, per pair of processes that touch one of its bodies, how many such bodies; the lists
+// are gathered, and each process in rank order takes the colour whose processes of lower rank
+// share the fewest bodies with it. Processes that share bodies and a colour remain where the
+// graph is not two-colourable (a 2 x 2 grid's diagonal neighbours, at the corner's few
+// bodies); the sweeps split those bodies' masses among them.
 std::pair<int, int> colour_processes(MPI_Comm comm, int nprocs, int me,
                                      const std::vector<int> &local_edges)
 {
@@ -110,19 +114,18 @@ std::pair<int, int> colour_processes(MPI_Comm comm, int nprocs, int me,
   std::vector<int> edges(std::size_t(displs[nprocs - 1] + counts[nprocs - 1]));
   MPI_Allgatherv(local_edges.data(), n_local, MPI_INT, edges.data(), counts.data(), displs.data(),
                  MPI_INT, comm);
-  std::vector<std::vector<int>> lower(nprocs); // each process's neighbours of lower rank
-  for (std::size_t e = 0; e + 1 < edges.size(); e += 2)
-    lower[std::max(edges[e], edges[e + 1])].push_back(std::min(edges[e], edges[e + 1]));
+  if (edges.empty()) return {1, 0};
+  // (a, b, bodies) triples, a < b: each process's weights to its neighbours of lower rank
+  std::vector<std::vector<std::pair<int, long>>> lower(nprocs);
+  for (std::size_t e = 0; e + 2 < edges.size(); e += 3)
+    lower[edges[e + 1]].emplace_back(edges[e], edges[e + 2]);
   std::vector<int> colour(nprocs, 0);
-  int colours = 1;
   for (int r = 0; r < nprocs; ++r) {
-    std::vector<char> taken(lower[r].size() + 1, 0);
-    for (const int q : lower[r])
-      if (colour[q] < static_cast<int>(taken.size())) taken[colour[q]] = 1;
-    while (taken[colour[r]]) ++colour[r];
-    colours = std::max(colours, colour[r] + 1);
+    long shared[2] = {0, 0};
+    for (const auto &[q, bodies] : lower[r]) shared[colour[q]] += bodies;
+    colour[r] = shared[1] < shared[0] ? 1 : 0;
   }
-  return {colours, colour[me]};
+  return {2, colour[me]};
 }
 
 } // namespace
@@ -208,31 +211,25 @@ std::unique_ptr<fibre::Exchange::Halo> LammpsExchange::halo(const std::vector<ch
     }
     shared.push_back(std::move(link));
   }
-  // the pairs of processes that touch a body owned here (this one too where it touches it)
+  // per pair of processes that touch a body owned here (this one too where it touches it),
+  // how many such bodies
   std::vector<std::vector<int>> touching(num_owned_);
   for (int k = 0; k < num_owned_; ++k)
     if (touched[k]) touching[k].push_back(me);
-  for (int k = num_owned_; k < nbody; ++k) // periodic images touched here: their bodies
-    if (touched[k] && local_owners_[k] != k &&
-        (touching[local_owners_[k]].empty() || touching[local_owners_[k]].back() != me))
-      touching[local_owners_[k]].push_back(me);
   for (const Link &l : shared)
     for (const int k : l.bodies)
       if (touching[k].empty() || touching[k].back() != l.rank) touching[k].push_back(l.rank);
-  std::vector<int> edges;
+  std::map<std::pair<int, int>, int> pairs;
   for (const std::vector<int> &ranks : touching)
     for (std::size_t i = 0; i < ranks.size(); ++i)
-      for (std::size_t j = i + 1; j < ranks.size(); ++j) {
-        edges.push_back(std::min(ranks[i], ranks[j]));
-        edges.push_back(std::max(ranks[i], ranks[j]));
-      }
-  // duplicates cost only the gather
-  std::vector<std::pair<int, int>> pairs;
-  for (std::size_t e = 0; e < edges.size(); e += 2) pairs.emplace_back(edges[e], edges[e + 1]);
-  std::sort(pairs.begin(), pairs.end());
-  pairs.erase(std::unique(pairs.begin(), pairs.end()), pairs.end());
-  edges.clear();
-  for (const auto &[a, b] : pairs) edges.push_back(a), edges.push_back(b);
+      for (std::size_t j = i + 1; j < ranks.size(); ++j)
+        ++pairs[{std::min(ranks[i], ranks[j]), std::max(ranks[i], ranks[j])}];
+  std::vector<int> edges;
+  for (const auto &[ranks, bodies] : pairs) {
+    edges.push_back(ranks.first);
+    edges.push_back(ranks.second);
+    edges.push_back(bodies);
+  }
   const auto [colours, colour] = colour_processes(halo_comm_, nprocs, me, edges);
   return std::make_unique<PointHalo>(halo_comm_, std::move(ghosts), std::move(shared),
                                      std::move(images), colours, colour);

@@ -112,18 +112,30 @@ std::vector<char> touched_bodies(const ContactSystem &sys, const Exchange &ex)
   return touched;
 }
 
-// Mass splitting (pgs.hpp): per body, 6 entries each, the number of processes whose contacts
-// move it (at least 1), on its owner and its ghosts. Empty where no body is shared.
-Vector body_splits(const std::vector<char> &touched, const Exchange &ex)
+// Per body (6 entries each, on its owner and its ghosts): how many processes' contacts move
+// it (`total`), and how many of those have this process's colour (`split`, at least 1: mass
+// splitting's share, pgs.hpp). `total` is empty where no body is shared, `split` where no two
+// processes of one colour share one.
+struct BodyShares {
+  Vector total, split;
+};
+BodyShares body_shares(const std::vector<char> &touched, const Exchange &ex, int colour)
 {
-  Vector split = Vector::Zero(Eigen::Index(kBodyDofs) * Eigen::Index(touched.size()));
-  for (std::size_t body = 0; body < touched.size(); ++body)
-    if (touched[body]) split.segment<kBodyDofs>(Eigen::Index(kBodyDofs) * body).setOnes();
-  ex.reverse_sum(split);
-  ex.forward(split);
-  split = split.cwiseMax(1.0);
-  const double shared = ex.max(split.size() ? split.maxCoeff() : 1.0);
-  return shared > 1.0 ? split : Vector();
+  const Eigen::Index n = Eigen::Index(touched.size());
+  Vector count = Vector::Zero(Eigen::Index(kBodyDofs) * n); // per colour: entries 0 and 1
+  for (Eigen::Index body = 0; body < n; ++body)
+    if (touched[body]) count[kBodyDofs * body + colour] = 1.0;
+  ex.reverse_sum(count);
+  ex.forward(count);
+  BodyShares shares{Vector(count.size()), Vector(count.size())};
+  for (Eigen::Index body = 0; body < n; ++body) {
+    const double *c = count.data() + kBodyDofs * body;
+    shares.total.segment<kBodyDofs>(kBodyDofs * body).setConstant(std::max(1.0, c[0] + c[1]));
+    shares.split.segment<kBodyDofs>(kBodyDofs * body).setConstant(std::max(1.0, c[colour]));
+  }
+  if (!(ex.max(n ? shares.total.maxCoeff() : 1.0) > 1.0)) return BodyShares();
+  if (!(ex.max(n ? shares.split.maxCoeff() : 1.0) > 1.0)) shares.split = Vector();
+  return shares;
 }
 
 // The contacts that a full sweep moved by at least kFocusShare of its mean change^2: those
@@ -313,20 +325,23 @@ PgsResult pgs(const ContactSystem &sys, const Exchange &ex, const Cones &cones, 
   const bool accelerate = control.anderson > 0 && !control.nonlinear_cg && !control.fibre_blocks;
   const bool focus =
       control.focus_sweeps > 0 && !control.nonlinear_cg && !control.fibre_blocks && !accelerate;
-  // Mass splitting: the sweeps see a shared body's copy, of inverse mass split / m. Not with
-  // fibre blocks, whose corrections move their bodies at their own mass, nor with nonlinear
-  // CG, whose steps along its direction it slowed (12 of test_fix_solvers' 60 steps at np 2
-  // unconverged).
-  const Vector shares =
-      halo && !control.fibre_blocks && !control.nonlinear_cg ? body_splits(touched, ex) : Vector();
-  // Process colours (Exchange::Halo::colours): the contacts on shared bodies are swept one
-  // colour at a time, so that a shared body moves at its own mass as on one process; with more
-  // colours than kMaxColours, or focused sweeps, its mass is split instead.
-  const int colours = shares.size() && !focus ? copies->colours() : 1;
-  const bool coloured = colours > 1 && colours <= kMaxColours;
-  const Vector split = coloured ? Vector() : shares;
+  // Two process colours (Exchange::Halo::colours): the contacts on bodies that other
+  // processes' contacts move too are swept in their process's colour's phase of the sweep, so
+  // that a body that processes of two colours share moves as on one process. A body that
+  // processes of one colour share (all of them without colours) is split among them: each sees
+  // a copy of inverse mass split / m (mass splitting). Neither with fibre blocks, whose
+  // corrections move their bodies at their own mass, nor with nonlinear CG, whose steps along
+  // its direction the split slowed (12 of test_fix_solvers' 60 steps at np 2 unconverged);
+  // focused sweeps split only.
+  const bool shareable = halo && !control.fibre_blocks && !control.nonlinear_cg;
+  const int colours = shareable && !focus ? copies->colours() : 1;
+  const int colour = colours > 1 ? copies->colour() : 0;
+  const BodyShares shares = shareable ? body_shares(touched, ex, colour) : BodyShares();
+  const Vector &split = shares.split;
   std::vector<std::vector<int>> phases;
-  if (coloured) phases = colour_phases(sys, ex, shares, colours, copies->colour());
+  if (colours > 1 && shares.total.size())
+    phases = colour_phases(sys, ex, shares.total, colours, colour);
+  const bool coloured = !phases.empty();
   Vector split_inv_mass;
   std::vector<Vec6> inv_scale(scale.size());
   if (split.size()) {

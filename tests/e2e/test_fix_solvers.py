@@ -28,7 +28,7 @@ import fibre_e2e as e2e
 DECK = """atom_style sphere
 boundary p p f
 newton off
-processors * 1 1
+processors {grid}
 comm_modify vel yes
 region box block -0.55 3.85 -0.55 3.85 0 8 units box
 create_box 1 box
@@ -63,6 +63,7 @@ SOLVERS = {
     "focus": "tol 1e-6 sweeps 20000 focus_sweeps 3",
     "anderson": "tol 1e-6 sweeps 20000 anderson 3",
     "default": "",
+    "grid": "",  # the defaults at np 4 on a 2 x 2 x 1 grid
 }
 
 
@@ -71,9 +72,10 @@ def main():
     ck = e2e.Checks("solvers: serial and two processes agree to the solver tolerance")
     for label, opts in SOLVERS.items():
         dumps, failed, worst_estimate, sweeps = {}, {}, {}, {}
-        for np in (1, 2, 4) if label == "default" else (1, 2):
+        for np in {"default": (1, 2, 4), "grid": (1, 4)}.get(label, (1, 2)):
             name = "solvers_%s_np%d" % (label, np)
-            run = e2e.run_lmp(args, DECK.format(opts=opts, name=name), name, np=np)
+            grid = "2 2 1" if label == "grid" and np == 4 else "* 1 1"
+            run = e2e.run_lmp(args, DECK.format(opts=opts, name=name, grid=grid), name, np=np)
             if not ck.ran(run):
                 continue
             failed[np] = run.last("f_fc[12]")
@@ -83,7 +85,7 @@ def main():
             rows = [row["f_fc[14]"] for block in run.thermo for row in block]
             sweeps[np] = sum(rows) / max(len(rows), 1)  # the sweeps per step
             dumps[np] = [e2e.dump_by_id(f) for f in e2e.parse_dump(args.workdir + "/" + name + ".dump")]
-        if 1 not in dumps or 2 not in dumps:
+        if 1 not in dumps or len(dumps) < 2:
             continue
 
         def difference(frame, np=2):
@@ -92,10 +94,10 @@ def main():
             dv = max(abs(a[i][k] - b[i][k]) for i in a for k in ("vx", "vy", "vz"))
             return dx, dv
 
-        dx, dv = difference(1)  # step 10
+        dx, dv = difference(1, min(n for n in dumps if n > 1))  # step 10
         agree = dx < 1e-9 and dv < 1e-6
         # checked below, with their own tolerances
-        if label not in ("fbgs", "apgd", "tol", "focus", "anderson", "default"):
+        if label not in ("fbgs", "apgd", "tol", "focus", "anderson", "default", "grid"):
             ck.check(agree or (failed[1] > 0 and failed[2] > 0),
                      "%s: np 2 agrees with serial after 10 steps, or both runs report the steps "
                      "whose solve did not converge" % label,
@@ -143,15 +145,23 @@ def main():
                 dx4, dv4 = difference(1, 4)
                 ck.check(dx4 < 1e-4 and dv4 < 2e-3, "default: np 4 within 1e-4 m and 2e-3 m/s "
                          "of serial", "%.2g m, %.2g m/s" % (dx4, dv4))
-        if label in ("pgs", "default"):
-            # The slabs of `processors * 1 1` take two colours: each process sweeps the contacts
-            # on bodies it shares in its own colour's phase, so a sweep is one process's
-            # Gauss-Seidel sweep, and it takes serial's sweeps (mass splitting, which shares out
-            # those bodies' masses, took 47% and 44% more here: 355 and 30.3 a step against 241
-            # and 21.1).
+        if label == "grid":
+            # 2 x 2 processes share bodies with all three others: the two colours separate the
+            # neighbours across each face, and the diagonal pairs split the corner's bodies
+            ck.check(dx < 1e-4 and dv < 2e-3, "grid: the defaults at np 4 on a 2 x 2 x 1 grid "
+                     "within 1e-4 m and 2e-3 m/s of serial", "%.2g m, %.2g m/s" % (dx, dv))
+        if label in ("pgs", "default", "grid"):
+            # Two colours: each process sweeps the contacts on bodies it shares in its own
+            # colour's phase, so a sweep on slabs (`processors * 1 1`) is one process's
+            # Gauss-Seidel sweep, and on the grid nearly so (its corner's bodies are split).
+            # Mass splitting alone, which shares out those bodies' masses, took 47% and 44%
+            # more sweeps on slabs (355 and 30.3 a step against 241 and 21.1) and 66% more on
+            # the grid (34.9); measured now: 0.4% and 8%, and 12% on the grid.
+            limit = 1.25 if label == "grid" else 1.15
             for np in sorted(n for n in sweeps if n > 1):
-                ck.check(sweeps[np] <= 1.15 * sweeps[1],
-                         "%s: np %d takes at most 15%% more sweeps a step than serial" % (label, np),
+                ck.check(sweeps[np] <= limit * sweeps[1],
+                         "%s: np %d takes at most %d%% more sweeps a step than serial"
+                         % (label, np, round(100 * (limit - 1))),
                          "%.1f against %.1f" % (sweeps[np], sweeps[1]))
         if label in ("nncg", "sweep_cg"):  # these converge on every step of this scene
             ck.check(agree and failed[1] == 0 and failed[2] == 0,

@@ -48,9 +48,10 @@ class Exchange {
     // reverse_sum, then forward, on those bodies only. Copies that no process touches, and
     // ghosts that this process does not touch, keep their values.
     virtual void sum_copies(Vector &body_vec) const = 0;
-    // A colouring of the processes in which two that touch a common body differ: the sweeps
-    // can then visit the contacts on shared bodies one colour at a time, as one process would
-    // (pgs.cpp). One colour: no colouring (the sweeps split the shared bodies' masses).
+    // Two colours for the processes, so that as few processes as may be that touch a common
+    // body share a colour (alike on every process): the sweeps visit the contacts on shared
+    // bodies one colour at a time, as one process would, and split the masses of the bodies
+    // that processes of one colour share (pgs.hpp). One colour: none (every shared body split).
     virtual int colours() const { return 1; }
     virtual int colour() const { return 0; }
   };

@@ -51,9 +51,6 @@ struct PgsControl {
 };
 
 inline constexpr int kRateWindow = 5;
-// Process colourings with more colours than this split the shared bodies' masses instead: each
-// colour costs a halo exchange per sweep.
-inline constexpr int kMaxColours = 2;
 inline constexpr double kAndersonSafety = 2.0;
 // Anderson's sweeps without a new smallest change after which the sweeps go on plain, from
 // the best checkpointed sweep (at most stall_sweeps).
@@ -100,14 +97,15 @@ struct PgsResult {
 // Sweeps from lambda (feasible or not; it is projected contact by contact). `sys` must have
 // every row active; `scale` comes from row_scales(sys). In parallel each process sweeps its
 // own contacts, and the bodies that several processes' contacts move get the sum of their
-// changes (Exchange::Halo). Where the halo's process colouring has at most kMaxColours colours,
-// a sweep is one phase per colour, and the contacts on shared bodies are swept only in their
-// process's phase (a halo exchange ends each phase): one process's Gauss-Seidel sweep in
-// another order. Otherwise a body whose contacts n processes sweep is split into n copies of
-// mass m / n, one on each, whose velocity changes are summed after every sweep (mass
-// splitting, Tonge, Benevolenskiy and Pfeiffer 2012). Without either each process would
-// correct a shared body by all that its own contacts ask, and together they overshoot (block
-// Jacobi: 458 sweeps a step against 15 on one process).
+// changes (Exchange::Halo). With the halo's two process colours a sweep is two phases, and the
+// contacts on shared bodies are swept only in their process's colour's phase (a halo exchange
+// ends each phase): where the processes that share a body differ in colour, one process's
+// Gauss-Seidel sweep in another order. A body whose contacts n processes of one colour sweep
+// (any n processes without colours) is split into n copies of mass m / n, one on each, whose
+// velocity changes are summed after the phase (mass splitting, Tonge, Benevolenskiy and
+// Pfeiffer 2012). Without either each process would correct a shared body by all that its own
+// contacts ask, and together they overshoot (block Jacobi: 458 sweeps a step against 15 on one
+// process).
 // A sweep that produces non-finite values stops with StopReason::non_finite, its impulses
 // back at the last checkpoint (at most 16 sweeps back; the start for the first 16).
 PgsResult pgs(const ContactSystem &sys, const Exchange &ex, const Cones &cones, const Vector &b,
