@@ -1,9 +1,11 @@
 #include "fibre/pgs.hpp"
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <limits>
 #include <memory>
+#include <numeric>
 
 #include "fibre/contact_rows.hpp"
 #include "fibre/fibre_blocks.hpp"
@@ -119,10 +121,11 @@ std::vector<char> touched_bodies(const ContactSystem &sys, const Exchange &ex)
 struct BodyShares {
   Vector total, split;
 };
-BodyShares body_shares(const std::vector<char> &touched, const Exchange &ex, int colour)
+BodyShares body_shares(const std::vector<char> &touched, const Exchange &ex, int colours,
+                       int colour)
 {
   const Eigen::Index n = Eigen::Index(touched.size());
-  Vector count = Vector::Zero(Eigen::Index(kBodyDofs) * n); // per colour: entries 0 and 1
+  Vector count = Vector::Zero(Eigen::Index(kBodyDofs) * n); // entry k: the processes of colour k
   for (Eigen::Index body = 0; body < n; ++body)
     if (touched[body]) count[kBodyDofs * body + colour] = 1.0;
   ex.reverse_sum(count);
@@ -130,7 +133,8 @@ BodyShares body_shares(const std::vector<char> &touched, const Exchange &ex, int
   BodyShares shares{Vector(count.size()), Vector(count.size())};
   for (Eigen::Index body = 0; body < n; ++body) {
     const double *c = count.data() + kBodyDofs * body;
-    shares.total.segment<kBodyDofs>(kBodyDofs * body).setConstant(std::max(1.0, c[0] + c[1]));
+    const double total = std::accumulate(c, c + colours, 0.0);
+    shares.total.segment<kBodyDofs>(kBodyDofs * body).setConstant(std::max(1.0, total));
     shares.split.segment<kBodyDofs>(kBodyDofs * body).setConstant(std::max(1.0, c[colour]));
   }
   if (!(ex.max(n ? shares.total.maxCoeff() : 1.0) > 1.0)) return BodyShares();
@@ -334,9 +338,10 @@ PgsResult pgs(const ContactSystem &sys, const Exchange &ex, const Cones &cones, 
   // its direction the split slowed (12 of test_fix_solvers' 60 steps at np 2 unconverged);
   // focused sweeps split only.
   const bool shareable = halo && !control.fibre_blocks && !control.nonlinear_cg;
-  const int colours = shareable && !focus ? copies->colours() : 1;
+  // (the counts per colour travel in a body's kBodyDofs entries)
+  const int colours = shareable && !focus && copies->colours() <= kBodyDofs ? copies->colours() : 1;
   const int colour = colours > 1 ? copies->colour() : 0;
-  const BodyShares shares = shareable ? body_shares(touched, ex, colour) : BodyShares();
+  const BodyShares shares = shareable ? body_shares(touched, ex, colours, colour) : BodyShares();
   const Vector &split = shares.split;
   std::vector<std::vector<int>> phases;
   if (colours > 1 && shares.total.size())
