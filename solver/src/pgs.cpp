@@ -431,9 +431,9 @@ PgsResult pgs(const ContactSystem &sys, const Exchange &ex, const Cones &cones, 
       }
     };
     if (coloured) {
-      for (const std::vector<int> &phase : phases) {
-        dv_start = dv;
-        sweep_and_sum(phase.data(), static_cast<int>(phase.size()));
+      for (std::size_t p = 0; p < phases.size(); ++p) {
+        if (p > 0) dv_start = dv; // the first phase starts where the sweep does
+        sweep_and_sum(phases[p].data(), static_cast<int>(phases[p].size()));
       }
     } else {
       sweep_and_sum(list, count);
