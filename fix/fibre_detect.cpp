@@ -23,6 +23,25 @@ void LammpsDetection::init_walls(const std::vector<fibre::WallSpec> &walls)
     if (!walls[w].is_plane()) init_host_wall(w);
 }
 
+// Whether the atoms are stored as at the last call: no neighbour build since (LAMMPS exchanges
+// and sorts atoms and rebuilds the ghosts only then) and the same tags and group bits, which a
+// dynamic group or a command between runs may change. Records them for the next call.
+bool LammpsDetection::same_atoms(int nlocal, int nall)
+{
+  const tagint *tag = atom->tag;
+  const int *mask = atom->mask;
+  bool same = neighbor->ago > 0 && nlocal == last_nlocal_ &&
+              static_cast<std::size_t>(nall) == last_atoms_.size();
+  for (int i = 0; same && i < nall; ++i)
+    same = last_atoms_[i].first == tag[i] && last_atoms_[i].second == ((mask[i] & groupbit_) != 0);
+  if (!same) {
+    last_nlocal_ = nlocal;
+    last_atoms_.resize(nall);
+    for (int i = 0; i < nall; ++i) last_atoms_[i] = {tag[i], (mask[i] & groupbit_) != 0};
+  }
+  return same;
+}
+
 std::vector<fibre::Body> LammpsDetection::bodies()
 {
   const int nlocal = atom->nlocal, nall = nlocal + atom->nghost;
@@ -31,25 +50,29 @@ std::vector<fibre::Body> LammpsDetection::bodies()
   double **x = atom->x;
 
   // Owned atoms by tag, ghosts by tag and position: the system does not depend on the atoms'
-  // storage order.
-  std::vector<int> body_atom, ghosts;
-  for (int i = 0; i < nlocal; ++i)
-    if (mask[i] & groupbit_) body_atom.push_back(i);
-  for (int i = nlocal; i < nall; ++i)
-    if (mask[i] & groupbit_) ghosts.push_back(i);
-  std::sort(body_atom.begin(), body_atom.end(), [tag](int a, int b) { return tag[a] < tag[b]; });
-  std::sort(ghosts.begin(), ghosts.end(), [tag, x](int a, int b) {
-    if (tag[a] != tag[b]) return tag[a] < tag[b];
-    for (int d = 0; d < 3; ++d)
-      if (x[a][d] != x[b][d]) return x[a][d] < x[b][d];
-    return a < b;
-  });
-  const int nowned = static_cast<int>(body_atom.size());
-  body_atom.insert(body_atom.end(), ghosts.begin(), ghosts.end());
+  // storage order. Between neighbour builds the storage order holds, and so does this one.
+  if (!same_atoms(nlocal, nall)) {
+    std::vector<int> body_atom, ghosts;
+    for (int i = 0; i < nlocal; ++i)
+      if (mask[i] & groupbit_) body_atom.push_back(i);
+    for (int i = nlocal; i < nall; ++i)
+      if (mask[i] & groupbit_) ghosts.push_back(i);
+    std::sort(body_atom.begin(), body_atom.end(), [tag](int a, int b) { return tag[a] < tag[b]; });
+    std::sort(ghosts.begin(), ghosts.end(), [tag, x](int a, int b) {
+      if (tag[a] != tag[b]) return tag[a] < tag[b];
+      for (int d = 0; d < 3; ++d)
+        if (x[a][d] != x[b][d]) return x[a][d] < x[b][d];
+      return a < b;
+    });
+    const int nowned = static_cast<int>(body_atom.size());
+    body_atom.insert(body_atom.end(), ghosts.begin(), ghosts.end());
+    exchange_.set_bodies(body_atom, nowned);
+    atom_body_.assign(nall, -1);
+    for (int k = 0; k < static_cast<int>(body_atom.size()); ++k) atom_body_[body_atom[k]] = k;
+  }
+  const std::vector<int> &body_atom = exchange_.body_atom();
+  const int nowned = exchange_.num_owned();
   const int nbody = static_cast<int>(body_atom.size());
-  exchange_.set_bodies(body_atom, nowned);
-  atom_body_.assign(nall, -1);
-  for (int k = 0; k < nbody; ++k) atom_body_[body_atom[k]] = k;
 
   double **v = atom->v, **omega = atom->omega, **f = atom->f, **torque = atom->torque;
   fibre::Vector vel = fibre::Vector::Zero(6 * Eigen::Index(nbody));

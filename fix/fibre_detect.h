@@ -7,6 +7,7 @@
 #pragma once
 
 #include <memory>
+#include <utility>
 #include <vector>
 
 #include "fibre/detection.hpp"
@@ -63,6 +64,8 @@ class LammpsDetection : protected LAMMPS_NS::Pointers {
   void host_wall_contacts(int wall, const std::vector<fibre::Body> &bodies, double h,
                           double damping, std::vector<fibre::DetectedContact> &found) const;
 
+  bool same_atoms(int nlocal, int nall);
+
   int groupbit_;
   LammpsExchange &exchange_;
   std::vector<fibre::WallSpec> walls_;
@@ -72,6 +75,8 @@ class LammpsDetection : protected LAMMPS_NS::Pointers {
   std::size_t last_found_ = 0; // contacts found in the last step
   std::unique_ptr<HostWalls> host_walls_;
   std::vector<int> atom_body_; // local atom -> body index, -1 if not a body
+  int last_nlocal_ = -1;       // the atoms at the last call of bodies(): owned count, and per
+  std::vector<std::pair<LAMMPS_NS::tagint, bool>> last_atoms_; // atom its tag and group bit
 };
 
 } // namespace fibre_lmp
