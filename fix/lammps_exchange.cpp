@@ -155,7 +155,8 @@ const std::vector<int> &LammpsExchange::ghost_owners() const
   return ghost_owners_;
 }
 
-std::unique_ptr<fibre::Exchange::Halo> LammpsExchange::halo(const std::vector<char> &touched) const
+std::unique_ptr<fibre::Exchange::Halo> LammpsExchange::halo(const std::vector<char> &touched,
+                                                            bool colour) const
 {
   using Link = PointHalo::Link;
   const int nprocs = lmp_->comm->nprocs, me = lmp_->comm->me;
@@ -211,6 +212,9 @@ std::unique_ptr<fibre::Exchange::Halo> LammpsExchange::halo(const std::vector<ch
     }
     shared.push_back(std::move(link));
   }
+  if (!colour)
+    return std::make_unique<PointHalo>(halo_comm_, std::move(ghosts), std::move(shared),
+                                       std::move(images));
   // per pair of processes that touch a body owned here (this one too where it touches it),
   // how many such bodies
   std::vector<std::vector<int>> touching(num_owned_);
@@ -230,9 +234,9 @@ std::unique_ptr<fibre::Exchange::Halo> LammpsExchange::halo(const std::vector<ch
     edges.push_back(ranks.second);
     edges.push_back(bodies);
   }
-  const auto [colours, colour] = colour_processes(halo_comm_, nprocs, me, edges);
+  const auto [colours, mine] = colour_processes(halo_comm_, nprocs, me, edges);
   return std::make_unique<PointHalo>(halo_comm_, std::move(ghosts), std::move(shared),
-                                     std::move(images), colours, colour);
+                                     std::move(images), colours, mine);
 }
 
 void LammpsExchange::set_bodies(const std::vector<int> &body_atom, int num_owned)

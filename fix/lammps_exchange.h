@@ -43,7 +43,7 @@ class LammpsExchange final : public fibre::Exchange {
   void max(double *values, int n) const override;
   long exclusive_prefix_sum(long local) const override;
   // Point to point between the processes that share the touched bodies (lammps_exchange.cpp).
-  std::unique_ptr<Halo> halo(const std::vector<char> &touched) const override;
+  std::unique_ptr<Halo> halo(const std::vector<char> &touched, bool colour) const override;
   const std::vector<int> &local_owners() const override { return local_owners_; }
   using fibre::Exchange::max;
   using fibre::Exchange::sum;

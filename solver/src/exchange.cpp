@@ -48,7 +48,7 @@ class FullHalo final : public Exchange::Halo {
 
 } // namespace
 
-std::unique_ptr<Exchange::Halo> Exchange::halo(const std::vector<char> &) const
+std::unique_ptr<Exchange::Halo> Exchange::halo(const std::vector<char> &, bool) const
 {
   return std::make_unique<FullHalo>(*this);
 }

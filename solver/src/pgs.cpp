@@ -103,6 +103,12 @@ void sweep(const ContactSystem &sys, const Cones &cones, const Vector &b, const 
   }
 }
 
+// The body that holds a local body's velocity: itself, or an image's body (Exchange::local_owners).
+int owner_of(const std::vector<int> &owners, int body)
+{
+  return owners.empty() ? body : owners[body];
+}
+
 // Per local body, whether this process's contacts move it (an image's velocity is its body's).
 std::vector<char> touched_bodies(const ContactSystem &sys, const Exchange &ex)
 {
@@ -110,7 +116,7 @@ std::vector<char> touched_bodies(const ContactSystem &sys, const Exchange &ex)
   const int *pairs = sys.body_pairs();
   std::vector<char> touched(sys.num_bodies(), 0);
   for (int e = 0; e < 2 * sys.num_contacts(); ++e)
-    if (pairs[e] >= 0) touched[owners.empty() ? pairs[e] : owners[pairs[e]]] = 1;
+    if (pairs[e] >= 0) touched[owner_of(owners, pairs[e])] = 1;
   return touched;
 }
 
@@ -293,8 +299,7 @@ std::vector<std::vector<int>> colour_phases(const ContactSystem &sys, const Exch
 {
   const std::vector<int> &owners = ex.local_owners();
   const auto shared = [&](int body) {
-    return body >= 0 &&
-           shares[Eigen::Index(kBodyDofs) * (owners.empty() ? body : owners[body])] > 1.0;
+    return body >= 0 && shares[Eigen::Index(kBodyDofs) * owner_of(owners, body)] > 1.0;
   };
   const int nc = sys.num_contacts();
   std::vector<char> boundary(nc);
@@ -323,7 +328,6 @@ PgsResult pgs(const ContactSystem &sys, const Exchange &ex, const Cones &cones, 
   const int nc = sys.num_contacts(), rows = sys.rows();
   const bool halo = ex.has_halo(); // else the round trip below is the identity
   const std::vector<char> touched = halo ? touched_bodies(sys, ex) : std::vector<char>();
-  const std::unique_ptr<Exchange::Halo> copies = halo ? ex.halo(touched) : nullptr;
   // the blocks' corrections are not part of the sweeps' steps, and measured with them the
   // combination diverged on a stiff pile: plain sweeps only
   const bool accelerate = control.anderson > 0 && !control.nonlinear_cg && !control.fibre_blocks;
@@ -338,8 +342,10 @@ PgsResult pgs(const ContactSystem &sys, const Exchange &ex, const Cones &cones, 
   // its direction the split slowed (12 of test_fix_solvers' 60 steps at np 2 unconverged);
   // focused sweeps split only.
   const bool shareable = halo && !control.fibre_blocks && !control.nonlinear_cg;
+  const bool colouring = shareable && !focus;
+  const std::unique_ptr<Exchange::Halo> copies = halo ? ex.halo(touched, colouring) : nullptr;
   // (the counts per colour travel in a body's kBodyDofs entries)
-  const int colours = shareable && !focus && copies->colours() <= kBodyDofs ? copies->colours() : 1;
+  const int colours = colouring && copies->colours() <= kBodyDofs ? copies->colours() : 1;
   const int colour = colours > 1 ? copies->colour() : 0;
   const BodyShares shares = shareable ? body_shares(touched, ex, colours, colour) : BodyShares();
   const Vector &split = shares.split;
@@ -354,7 +360,7 @@ PgsResult pgs(const ContactSystem &sys, const Exchange &ex, const Cones &cones, 
     const std::vector<int> &owners = ex.local_owners();
     const auto split_of = [&](int body) {
       if (body < 0) return 1.0;
-      return split[Eigen::Index(kBodyDofs) * (owners.empty() ? body : owners[body])];
+      return split[Eigen::Index(kBodyDofs) * owner_of(owners, body)];
     };
     std::vector<Vec6> diagonal(nc);
     for (int c = 0; c < nc; ++c) {

@@ -56,8 +56,9 @@ class Exchange {
     virtual int colour() const { return 0; }
   };
   // touched: one flag per local body (owned, then ghosts), set where this process's contacts
-  // move it. A collective. The default sums every body's copies.
-  virtual std::unique_ptr<Halo> halo(const std::vector<char> &touched) const;
+  // move it. colour: whether the caller sweeps by Halo::colours (else one colour, and the
+  // colouring's collective is spared). A collective. The default sums every body's copies.
+  virtual std::unique_ptr<Halo> halo(const std::vector<char> &touched, bool colour) const;
 
   double sum(double x) const
   {
