@@ -82,16 +82,40 @@ void sort_contacts(std::vector<DetectedContact> &found)
     double partner, gap;
     std::size_t index;
   };
-  std::vector<Key> keys(found.size());
-  for (std::size_t i = 0; i < found.size(); ++i)
-    keys[i] = {found[i].tag_a, found[i].partner, found[i].contact.gap, i};
-  std::sort(keys.begin(), keys.end(), [](const Key &p, const Key &q) {
+  const auto before = [](const Key &p, const Key &q) {
     if (p.tag_a != q.tag_a) return p.tag_a < q.tag_a;
     if (p.partner != q.partner) return p.partner < q.partner;
     return p.gap < q.gap;
-  });
+  };
+  const std::size_t n = found.size();
+  if (n < 2) return;
+  std::vector<Key> keys(n);
+  long long lo = found[0].tag_a, hi = lo;
+  for (std::size_t i = 0; i < n; ++i) {
+    keys[i] = {found[i].tag_a, found[i].partner, found[i].contact.gap, i};
+    lo = std::min(lo, keys[i].tag_a);
+    hi = std::max(hi, keys[i].tag_a);
+  }
+  // Tags are dense on a process (its atoms and their ghosts): bucket the keys by tag_a, then
+  // order each bucket (a sphere's few contacts) by insertion. A sparse range: a full sort.
+  const unsigned long long range = static_cast<unsigned long long>(hi - lo) + 1;
+  if (range <= 4 * n + 1024) {
+    std::vector<std::size_t> first(range + 1, 0);
+    for (const Key &k : keys) ++first[std::size_t(k.tag_a - lo) + 1];
+    for (std::size_t t = 1; t <= range; ++t) first[t] += first[t - 1];
+    std::vector<Key> bucketed(n);
+    std::vector<std::size_t> fill(first.begin(), first.end() - 1);
+    for (const Key &k : keys) bucketed[fill[std::size_t(k.tag_a - lo)]++] = k;
+    for (std::size_t t = 0; t < range; ++t)
+      for (std::size_t i = first[t] + 1; i < first[t + 1]; ++i)
+        for (std::size_t j = i; j > first[t] && before(bucketed[j], bucketed[j - 1]); --j)
+          std::swap(bucketed[j], bucketed[j - 1]);
+    keys.swap(bucketed);
+  } else {
+    std::sort(keys.begin(), keys.end(), before);
+  }
   std::vector<DetectedContact> sorted;
-  sorted.reserve(found.size());
+  sorted.reserve(n);
   for (const Key &k : keys) sorted.push_back(std::move(found[k.index]));
   found.swap(sorted);
 }

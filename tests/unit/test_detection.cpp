@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <random>
+#include <tuple>
 
 #include "fibre/detection.hpp"
 
@@ -171,6 +172,34 @@ TEST(Detection, SortIsIndependentOfInputOrder)
   }
   EXPECT_EQ(found.front().tag_a, 1);
   EXPECT_EQ(found.front().partner, -2.0);
+}
+
+// Dense tags (bucketed by tag) and sparse ones (a full sort) give the order of the keys.
+TEST(Detection, SortOrdersByTagPartnerAndGap)
+{
+  for (const long long spread : {1LL, 1000000000LL}) {
+    std::mt19937 rng(11);
+    std::uniform_int_distribution<int> tag(1, 60), partner(-3, 80);
+    std::uniform_real_distribution<double> gap(-0.01, 0.01);
+    std::vector<DetectedContact> found(700);
+    for (DetectedContact &c : found) {
+      c.tag_a = spread * tag(rng);
+      c.partner = partner(rng);
+      c.contact.gap = gap(rng);
+    }
+    std::vector<DetectedContact> expected = found;
+    std::sort(expected.begin(), expected.end(), [](const auto &p, const auto &q) {
+      return std::make_tuple(p.tag_a, p.partner, p.contact.gap) <
+             std::make_tuple(q.tag_a, q.partner, q.contact.gap);
+    });
+    sort_contacts(found);
+    ASSERT_EQ(found.size(), expected.size());
+    for (std::size_t k = 0; k < found.size(); ++k) {
+      EXPECT_EQ(found[k].tag_a, expected[k].tag_a) << "spread " << spread << ", contact " << k;
+      EXPECT_EQ(found[k].partner, expected[k].partner);
+      EXPECT_EQ(found[k].contact.gap, expected[k].contact.gap);
+    }
+  }
 }
 
 TEST(Detection, WallNames)
