@@ -206,7 +206,7 @@ void LammpsDetection::pair_contacts(const std::vector<fibre::Body> &bodies, doub
         if (!accept(bodies[a], &bodies[b], normal, gap, h, damping, kick(a) + kick(b))) continue;
         // built only here: most listed pairs are no contact, and a Contact is hundreds of bytes
         fibre::DetectedContact &fc = found.emplace_back();
-        fc.contact = fibre::sphere_sphere_contact(bodies, a, b);
+        fc.contact = fibre::sphere_sphere_contact(bodies, a, b, normal, gap);
         fc.tag_a = tag[low];
         fc.partner = static_cast<double>(tag[high]);
         keep(fc);

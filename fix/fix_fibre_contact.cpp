@@ -613,7 +613,7 @@ void FixFibreContact::final_integrate()
   // the contacts take out, both from the velocities after the step (collective: every process)
   std::vector<std::array<double, fibre::kMaxRows>> springs;
   if (any) {
-    const fibre::Vector v_plus = fibre::velocities_after(sys, *exchange_, res.lambda);
+    const fibre::Vector v_plus = fibre::velocities_after_change(sys, *exchange_, res.dv);
     if (model.compliance.material) springs = fibre::advance_springs(sys, v_plus, res.lambda);
     output_->add_work(fibre::contact_work(sys, v_plus, res.lambda));
   }

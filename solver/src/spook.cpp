@@ -107,6 +107,16 @@ Vector velocities_after(const ContactSystem &sys, const Exchange &ex, const Vect
   return v_plus;
 }
 
+Vector velocities_after_change(const ContactSystem &sys, const Exchange &ex, Vector dv)
+{
+  Vector v_plus = body_velocities(sys) + external_velocity_change(sys);
+  if (dv.size() == v_plus.size()) {
+    ex.forward(dv);
+    v_plus += dv;
+  }
+  return v_plus;
+}
+
 ContactWork contact_work(const ContactSystem &sys, const Vector &v_plus, const Vector &lambda)
 {
   const Vector v_mid = 0.5 * (body_velocities(sys) + v_plus);

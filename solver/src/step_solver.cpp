@@ -257,6 +257,8 @@ void StepSolver::project(Vector &lambda) const
       const Cone &cone = kCones[k];
       const double radius = coeff(c, k) * ln;
       Eigen::Vector2d t = cone_values(lambda, base(c), cone);
+      // inside by a margin far above round-off: the square root (most cones stick) is spared
+      if (!state_[c].capped[k] && t.squaredNorm() <= (1 - 1e-12) * radius * radius) continue;
       if (state_[c].capped[k]) {
         t = radius * state_[c].dir[k];
       } else if (!(t.norm() <= radius)) {

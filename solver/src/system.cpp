@@ -24,11 +24,21 @@ void sphere_sphere_gap(const Body &A, const Body &B, Vec3 &normal, double &gap)
 
 Contact sphere_sphere_contact(const std::vector<Body> &bodies, int a, int b)
 {
-  const Body &A = bodies.at(a), &B = bodies.at(b);
+  Vec3 normal;
+  double gap = 0.0;
+  sphere_sphere_gap(bodies.at(a), bodies.at(b), normal, gap);
+  return sphere_sphere_contact(bodies, a, b, normal, gap);
+}
+
+Contact sphere_sphere_contact(const std::vector<Body> &bodies, int a, int b, const Vec3 &normal,
+                              double gap)
+{
+  const Body &B = bodies.at(b);
   Contact c;
   c.a = a;
   c.b = b;
-  sphere_sphere_gap(A, B, c.normal, c.gap);
+  c.normal = normal;
+  c.gap = gap;
   tangent_frame(c.normal, c.t1, c.t2);
   c.point = B.x + c.normal * (B.radius + 0.5 * c.gap);
   return c;

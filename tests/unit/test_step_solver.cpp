@@ -283,6 +283,11 @@ TEST(ContactSolver, RollingSpringAtTheConeKeepsTheConeLessItsDamper)
     const StepResult res = solve(sys, o);
     ASSERT_TRUE(res.converged);
     const Vector v_plus = velocities_after(sys, serial_exchange(), res.lambda);
+    // from the step's dv, as the fix takes it: the same velocities
+    const Vector from_dv = velocities_after_change(sys, serial_exchange(), res.dv);
+    ASSERT_EQ(from_dv.size(), v_plus.size());
+    EXPECT_EQ((from_dv - v_plus).cwiseAbs().maxCoeff(), 0.0) << own;
+    EXPECT_GT((v_plus - body_velocities(sys)).cwiseAbs().maxCoeff(), 0.0) << own;
     const std::array<double, kMaxRows> xi = advance_springs(sys, v_plus, res.lambda)[0];
     Vector Gv;
     g_apply(sys, v_plus, Gv);

@@ -28,6 +28,9 @@ Vector velocity_change(const ContactSystem &sys, const Exchange &ex, const Vecto
 // v+ = v + h M^-1 f + M^-1 G^T lambda, the velocities after the step, complete on ghosts.
 // Collective (velocity_change). lambda may be empty (no contacts): free flight.
 Vector velocities_after(const ContactSystem &sys, const Exchange &ex, const Vector &lambda);
+// The same from the step's velocity change dv = M^-1 G^T lambda on the owned bodies
+// (StepResult::dv; empty: free flight), forwarded to the ghosts: no second product.
+Vector velocities_after_change(const ContactSystem &sys, const Exchange &ex, Vector dv);
 
 // The step's work of the contact impulses, this process's contacts (sum over processes):
 // `wall_work` is done on the bodies by moving walls and obstacles, lambda . (G_b w_b) with w_b
