@@ -75,8 +75,10 @@ class LammpsDetection : protected LAMMPS_NS::Pointers {
   std::size_t last_found_ = 0; // contacts found in the last step
   std::unique_ptr<HostWalls> host_walls_;
   std::vector<int> atom_body_; // local atom -> body index, -1 if not a body
-  int last_nlocal_ = -1;       // the atoms at the last call of bodies(): owned count, and per
-  std::vector<std::pair<LAMMPS_NS::tagint, bool>> last_atoms_; // atom its tag and group bit
+  // the atoms at the last call of bodies() (same_atoms): the owned count, and per atom its tag
+  // and whether it is in the group
+  int last_nlocal_ = -1;
+  std::vector<std::pair<LAMMPS_NS::tagint, bool>> last_atoms_;
 };
 
 } // namespace fibre_lmp
