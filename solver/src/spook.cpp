@@ -170,7 +170,9 @@ advance_springs(const ContactSystem &sys, const Vector &v_plus, const Vector &la
       const double eps = k.compliance[rows_of.first];
       const double limit = eps * cones.coeff(c, cone) * lambda_n / h;
       const double tau = k.damper_time[rows_of.first];
-      if ((xi + tau * w).norm() > limit) {
+      // (a load inside the cone by a margin far above round-off spares the square root)
+      const Eigen::Vector2d load = xi + tau * w;
+      if (!(load.squaredNorm() <= (1 - 1e-12) * limit * limit) && load.norm() > limit) {
         const double ln = l.norm(), xn = xi.norm();
         if (ln > 0)
           xi = -limit / ln * l;
