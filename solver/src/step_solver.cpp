@@ -257,15 +257,13 @@ void StepSolver::project(Vector &lambda) const
       const Cone &cone = kCones[k];
       const double radius = coeff(c, k) * ln;
       Eigen::Vector2d t = cone_values(lambda, base(c), cone);
-      // inside by a margin far above round-off: the square root (most cones stick) is spared
-      if (!state_[c].capped[k] && t.squaredNorm() <= (1 - 1e-12) * radius * radius) continue;
       if (state_[c].capped[k]) {
         t = radius * state_[c].dir[k];
-      } else if (!(t.norm() <= radius)) {
+      } else if (t.squaredNorm() <= (1 - 1e-12) * radius * radius || t.norm() <= radius) {
+        continue; // inside (by a margin far above round-off: no square root; most cones stick)
+      } else {
         t = t.norm() > 0 && std::isfinite(t.norm()) ? Eigen::Vector2d(t * (radius / t.norm()))
                                                     : Eigen::Vector2d::Zero();
-      } else {
-        continue;
       }
       set_cone(lambda, base(c), cone, t);
     }
