@@ -550,7 +550,10 @@ def paired_stats(fibre, native):
     (NaN where a run has none, such as a clogged silo). Each twin's mean, range and standard
     deviation are over its own seeds with a value; the difference fibre - native is over the
     seeds where both have one, with the standard error of its mean (the spread of the
-    per-seed differences over sqrt(n)), and relative to native's mean over those seeds."""
+    per-seed differences over sqrt(n)), and relative to native's mean over those seeds.
+    "means" is the difference of the two twins' own means (each over its seeds with a value,
+    as issue #14 compares them: a clog drops one twin's seed only), with the standard error
+    sqrt(sd_f^2 / n_f + sd_n^2 / n_n), and relative to native's own mean."""
     def summary(v):
         x = np.array([y for y in v.values() if math.isfinite(y)], dtype=float)
         if len(x) == 0:
@@ -567,6 +570,13 @@ def paired_stats(fibre, native):
     out["diff_se"] = float(d.std(ddof=1) / math.sqrt(len(d))) if len(d) > 1 else float("nan")
     out["rel"] = out["diff"] / base if base else float("nan")
     out["rel_se"] = out["diff_se"] / abs(base) if base else float("nan")
+    f, n = out["fibre"], out["native"]
+    out["means"] = f["mean"] - n["mean"]
+    out["means_se"] = (math.sqrt(f["sd"] ** 2 / f["n"] + n["sd"] ** 2 / n["n"])
+                       if f["n"] > 1 and n["n"] > 1 else float("nan"))
+    out["means_rel"] = out["means"] / n["mean"] if n["n"] and n["mean"] else float("nan")
+    out["means_rel_se"] = (out["means_se"] / abs(n["mean"]) if n["n"] and n["mean"]
+                           else float("nan"))
     return out
 
 
@@ -637,21 +647,25 @@ def cmd_seeds(a):
                                       "; " + "; ".join(typed) if typed else ""),
              "", "| seed | " + " | ".join(head) + " |", "|---|" + "---|" * len(head)] + rows
     lines += ["", "| figure | native: mean (range), sd | fix: mean (range), sd | fix - native, "
-              "paired by seed (standard error) |", "|---|---|---|---|"]
+              "paired by seed (standard error) | fix - native, the means (standard error) |",
+              "|---|---|---|---|---|"]
 
-    def difference(st, fmt, relative):
+    def difference(st, fmt, relative, means=False):
+        """The paired difference (or, with means, the difference of the means) and its error."""
+        keys = ("means_rel", "means_rel_se", "means", "means_se") if means else \
+            ("rel", "rel_se", "diff", "diff_se")
         if relative:
-            return "%+.1f%% (%.1f%%)" % (100 * st["rel"], 100 * st["rel_se"])
-        return ("%+" + fmt[1:] + " (" + fmt + ")") % (st["diff"], st["diff_se"])
+            return "%+.1f%% (%.1f%%)" % (100 * st[keys[0]], 100 * st[keys[1]])
+        return ("%+" + fmt[1:] + " (" + fmt + ")") % (st[keys[2]], st[keys[3]])
 
     def twin(t, fmt):
         return "%s (%s..%s), %s, %d seeds" % (fmt % t["mean"], fmt % t["min"], fmt % t["max"],
                                               fmt % t["sd"], t["n"])
     for key, label, fmt, relative in figures:
         st = paired_stats(values["fibre"][key], values["native"][key])
-        lines.append("| %s | %s | %s | %s over %d seeds |" % (
+        lines.append("| %s | %s | %s | %s over %d seeds | %s |" % (
             label, twin(st["native"], fmt), twin(st["fibre"], fmt),
-            difference(st, fmt, relative), st["paired"]))
+            difference(st, fmt, relative), st["paired"], difference(st, fmt, relative, True)))
     if a.against_tag:
         # the fix's runs of another setting, read as they are (no --run)
         other = {key: {} for key, _, _, _ in figures}

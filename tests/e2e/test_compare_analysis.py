@@ -9,7 +9,8 @@ curves with known answers, no LAMMPS run:
 - a silo that runs empty: not clogged;
 - the seeds' statistics (paired_stats): each twin's mean, range and spread over its own
   seeds, the difference paired by seed with its standard error, a clogged seed (NaN) and a
-  seed one twin lacks left out of the pairs, against values worked out by hand.
+  seed one twin lacks left out of the pairs, and the difference of the twins' own means with
+  its standard error, against values worked out by hand.
 """
 
 import os
@@ -64,6 +65,12 @@ def main():
              and f["max"] == 5.2 and n["n"] == 4 and abs(n["mean"] - 4.825) < 1e-12
              and abs(n["sd"] - 0.125830573921179) < 1e-12, "each twin over its own seeds",
              "%s" % st)
+    # the means: 15.1 / 3 - 4.825 = 5 / 24; variances 7 / 300 (3 seeds) and 19 / 1200 (4), so
+    # the error is sqrt(7 / 900 + 19 / 4800) = 13 / 120
+    ck.check(abs(st["means"] - 5.0 / 24) < 1e-12 and abs(st["means_se"] - 13.0 / 120) < 1e-12
+             and abs(st["means_rel"] - 5.0 / 24 / 4.825) < 1e-12
+             and abs(st["means_rel_se"] - 13.0 / 120 / 4.825) < 1e-12,
+             "the difference of the twins' own means and its error", "%s" % st)
     ck.close()
 
 
