@@ -21,7 +21,8 @@ Subcommands (run from anywhere; paths default to this repository):
       WORKDIR/SCENE.N.T_sSEED; with --run: runs what is missing, J runs at a time), and per
       twin the mean, range and standard deviation of the heap's height and angle (material) or
       the discharge rate (silo, flowing seeds only), the wall seconds per simulated second,
-      and the fix's difference from native paired by seed with its standard error; writes
+      and the fix's difference from native, paired by seed and between the twins' own means,
+      each with its standard error; writes
       DIR/SCENE.N.seeds.T.md and prints it. With --native-tag T0 the native twin is read
       from (or run in) the directories of tag T0, so that several settings of the fix are
       set against one set of native runs. With --against-tag T1 the fix's runs are also
