@@ -653,11 +653,12 @@ def cmd_seeds(a):
 
     def difference(st, fmt, relative, means=False):
         """The paired difference (or, with means, the difference of the means) and its error."""
-        keys = ("means_rel", "means_rel_se", "means", "means_se") if means else \
-            ("rel", "rel_se", "diff", "diff_se")
+        rel, rel_se, value, se = (st[k] for k in (
+            ("means_rel", "means_rel_se", "means", "means_se") if means
+            else ("rel", "rel_se", "diff", "diff_se")))
         if relative:
-            return "%+.1f%% (%.1f%%)" % (100 * st[keys[0]], 100 * st[keys[1]])
-        return ("%+" + fmt[1:] + " (" + fmt + ")") % (st[keys[2]], st[keys[3]])
+            return "%+.1f%% (%.1f%%)" % (100 * rel, 100 * rel_se)
+        return ("%+" + fmt[1:] + " (" + fmt + ")") % (value, se)
 
     def twin(t, fmt):
         return "%s (%s..%s), %s, %d seeds" % (fmt % t["mean"], fmt % t["min"], fmt % t["max"],
