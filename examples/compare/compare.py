@@ -588,12 +588,14 @@ SEED_FIGURES = {"material": (("height", "height (m)", "%.2f", True),
 WALL_FIGURE = ("wall_per_s", "wall s / simulated s", "%.2f", True)
 
 
+def run_prefix(a, method):
+    """A twin's run directories' prefix: --native-tag's for native, else --tag's."""
+    return (a.native_tag if method == "native" and a.native_tag else a.tag) or "seeds"
+
+
 def seed_tag(a, seed, method="fibre", prefix=None):
-    """The run directory's tag of a seed's twin: prefix's, else --native-tag's for native,
-    else --tag's."""
-    if prefix is None:
-        prefix = a.native_tag if method == "native" and a.native_tag else a.tag
-    return "%s_s%s" % (prefix or "seeds", seed)
+    """The run directory's tag of a seed's twin: prefix's, else run_prefix's."""
+    return "%s_s%s" % (prefix or run_prefix(a, method), seed)
 
 
 def seed_figures(a, method, tag):
@@ -668,19 +670,23 @@ def cmd_seeds(a):
         lines.append("| %s | %s | %s | %s over %d seeds | %s |" % (
             label, twin(st["native"], fmt), twin(st["fibre"], fmt),
             difference(st, fmt, relative), st["paired"], difference(st, fmt, relative, True)))
-    if a.against_tag:
-        # the fix's runs of another setting, read as they are (no --run)
+    # a twin's runs of another setting, read as they are (no --run)
+    for m, who, prefix in (("fibre", "fix", a.against_tag),
+                           ("native", "native", a.native_against_tag)):
+        if not prefix:
+            continue
         other = {key: {} for key, _, _, _ in figures}
         for seed in a.seeds:
-            r = seed_figures(a, "fibre", seed_tag(a, seed, prefix=a.against_tag))
+            r = seed_figures(a, m, seed_tag(a, seed, prefix=prefix))
             for key, _, _, _ in figures:
                 other[key][seed] = r[key]
-        lines += ["", "| figure | fix (%s) - fix (%s), paired by seed (standard error) |"
-                  % (a.tag or "seeds", a.against_tag), "|---|---|"]
+        lines += ["", "| figure | %s (%s) - %s (%s), paired by seed (standard error) | the means "
+                  "(standard error) |" % (who, run_prefix(a, m), who, prefix), "|---|---|---|"]
         for key, label, fmt, relative in figures:
-            st = paired_stats(values["fibre"][key], other[key])
-            lines.append("| %s | %s over %d seeds |" % (label, difference(st, fmt, relative),
-                                                          st["paired"]))
+            st = paired_stats(values[m][key], other[key])
+            lines.append("| %s | %s over %d seeds | %s |" % (
+                label, difference(st, fmt, relative), st["paired"],
+                difference(st, fmt, relative, True)))
     wall = {m: np.mean(list(values[m]["wall_per_s"].values())) for m in METHODS}
     lines += ["", "Speed: native / fix = %.2fx (mean wall seconds per simulated second)."
               % (wall["native"] / wall["fibre"])]
@@ -793,6 +799,8 @@ def main():
                    help="native twin's run directories' prefix (default: --tag's)")
     s.add_argument("--against-tag", default=None,
                    help="also pair the fix with the fix's runs of this prefix")
+    s.add_argument("--native-against-tag", default=None,
+                   help="also pair native with native's runs of this prefix")
     s.add_argument("--out", default=DEFAULT_OUT)
     i = sub.add_parser("picture", help="PNG snapshot of a run with dump image")
     i.add_argument("scene", choices=PILE_SCENES)
