@@ -11,6 +11,7 @@
 #include "fibre/fibre_blocks.hpp"
 #include "fibre/kernels.hpp"
 #include "fibre/spook.hpp"
+#include "fibre/sweep_groups.hpp"
 
 namespace fibre {
 
@@ -399,6 +400,11 @@ PgsResult pgs(const ContactSystem &sys, const Exchange &ex, const Cones &cones, 
     blocks =
         std::make_unique<FibreBlocks>(sys, ex.local_owners(), cones, control.block_weight, &normal);
   }
+  // Four contacts at a time where the processor can (sweep_groups.hpp), for the full sweeps
+  // that are not split into colour phases
+  std::unique_ptr<GroupedSweep> grouped;
+  if (control.grouped && !coloured && !focus && nc > 0 && grouped_sweeps_available())
+    grouped = std::make_unique<GroupedSweep>(sys, cones, b, inv_mass, inv_scale, ex.local_owners());
   Anderson anderson(std::max(control.anderson, 1), ex);
   Vector steps(accelerate ? lambda.size() : 0);
   std::vector<double> contact_changes(focus ? nc : 0);
@@ -423,6 +429,11 @@ PgsResult pgs(const ContactSystem &sys, const Exchange &ex, const Cones &cones, 
     // Every process's updates on every body: the sum of the local changes, owners and ghosts
     // (each copy's change at the body's own mass); with colours after each colour's phase.
     const auto sweep_and_sum = [&](const int *visit, int n) {
+      if (grouped && !visit) {
+        grouped->sweep(lambda, dv, norms, mixing ? steps.data() : nullptr);
+        visit = grouped->singles().data(); // then the rest one at a time
+        n = static_cast<int>(grouped->singles().size());
+      }
       if (rows == 6)
         sweep<6>(sys, cones, b, inv_mass, inv_scale, ex.local_owners(), visit, n, lambda, dv, norms,
                  changes, mixing ? steps.data() : nullptr);

@@ -162,6 +162,10 @@ std::size_t read_solver_keyword(const Reader &in, std::size_t i, StepOptions &op
     if (!in.has(i + 1) || (in.at(i + 1) != "yes" && in.at(i + 1) != "no"))
       Reader::illegal("'sweep_cg yes|no'", in.has(i + 1) ? &in.at(i + 1) : nullptr);
     opt.sweep_cg = in.at(i + 1) == "yes";
+  } else if (key == "sweep_groups") {
+    if (!in.has(i + 1) || (in.at(i + 1) != "yes" && in.at(i + 1) != "no"))
+      Reader::illegal("'sweep_groups yes|no'", in.has(i + 1) ? &in.at(i + 1) : nullptr);
+    opt.sweep_groups = in.at(i + 1) == "yes";
   } else if (key == "sweep_blocks") {
     if (!in.has(i + 1) || (in.at(i + 1) != "yes" && in.at(i + 1) != "no"))
       Reader::illegal("'sweep_blocks yes|no'", in.has(i + 1) ? &in.at(i + 1) : nullptr);
@@ -287,6 +291,7 @@ Settings parse_settings(const std::vector<std::string> &args)
           "a keyword (form, solver, precond, weight, tol, linear_tol, pass_tol, maxiter, "
           "compliance, damping, mu, mu_roll, mu_twist, rows, active_set, sweeps, "
           "sweep_tol, rescue_sweeps, min_sweeps, focus_sweeps, anderson, sweep_cg, sweep_blocks, "
+          "sweep_groups, "
           "recovery_speed, restitution, bounce_speed, coefficients, normal_relaxation, wall, "
           "export)",
           &key);

@@ -25,7 +25,8 @@ std::string describe(const StepOptions &opt)
          ", rescue_sweeps " + std::to_string(opt.rescue_sweeps) + ", min_sweeps " +
          std::to_string(opt.min_sweeps) + ", focus_sweeps " + std::to_string(opt.focus_sweeps) +
          ", anderson " + std::to_string(opt.anderson) + (opt.sweep_cg ? ", sweep_cg yes" : "") +
-         (opt.sweep_blocks ? ", sweep_blocks yes" : "");
+         (opt.sweep_blocks ? ", sweep_blocks yes" : "") +
+         (opt.sweep_groups ? "" : ", sweep_groups no");
 }
 
 namespace {
@@ -291,6 +292,7 @@ void StepSolver::finish(Vector &lambda, StepResult &res) const
     control.min_sweeps = opt_.min_sweeps;
     control.focus_sweeps = opt_.focus_sweeps;
     control.anderson = opt_.anderson;
+    control.grouped = opt_.sweep_groups;
     control.nonlinear_cg = opt_.sweep_cg || opt_.solver == Method::nncg;
     control.fibre_blocks = opt_.sweep_blocks || opt_.solver == Method::fbgs;
     control.block_weight = opt_.precond.weight;

@@ -2,9 +2,11 @@
 // (the same impulses as the settled MUMPS answer), and every stop has its typed reason.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <limits>
+#include <numeric>
 #include <utility>
 
 #include "fibre/apgd.hpp"
@@ -13,6 +15,7 @@
 #include "fibre/scenes.hpp"
 #include "fibre/spook.hpp"
 #include "fibre/step_solver.hpp"
+#include "fibre/sweep_groups.hpp"
 #include "reference.hpp"
 
 using namespace fibre;
@@ -443,4 +446,126 @@ TEST(Pgs, FocusedSweepsReachTheReferenceOnFewerVisits)
   EXPECT_LT(ef.lambda_n, 2.0 * ep.lambda_n + 1e-5);
   EXPECT_LT(ef.velocity(), 2.0 * ep.velocity() + 1e-5);
   EXPECT_EQ(af.full_sweeps.back(), af.sweeps - 1); // it stopped on a full sweep
+}
+
+namespace {
+
+// The same contacts in another order (rows 3 or 6 as `rows`), with its rhs.
+Problem reordered(const ContactSystem &sys, const std::vector<int> &order, int rows)
+{
+  std::vector<Contact> contacts;
+  for (int c : order) contacts.push_back(sys.contacts()[c]);
+  Problem pr{ContactSystem(sys.bodies(), contacts, rows, sys.params()), Vector()};
+  pr.b = spook_rhs(pr.sys);
+  return pr;
+}
+
+// The groups' order of the contacts: group by group, the empty lanes left out, then the singles.
+std::vector<int> group_order(const ContactGroups &grouped)
+{
+  std::vector<int> order;
+  for (const ContactGroup &g : grouped.groups)
+    for (int c : g)
+      if (c >= 0) order.push_back(c);
+  order.insert(order.end(), grouped.singles.begin(), grouped.singles.end());
+  return order;
+}
+
+} // namespace
+
+// Every contact is in one group or among the singles, no group holds a body twice (a periodic
+// image counts as its body), and a body against its own image is a single.
+TEST(SweepGroups, ShareNoBodyAndHoldEveryContactOnce)
+{
+  const Problem pr = pile(300, 0.4);
+  const ContactGroups grouped = group_contacts(pr.sys, {});
+  EXPECT_TRUE(grouped.singles.empty());
+  std::vector<int> seen(pr.sys.num_contacts(), 0);
+  int full = 0;
+  for (const ContactGroup &g : grouped.groups) {
+    std::vector<int> bodies;
+    int lanes = 0;
+    for (int c : g) {
+      if (c < 0) continue;
+      ++lanes;
+      ++seen[c];
+      const Contact &k = pr.sys.contacts()[c];
+      bodies.push_back(k.a);
+      if (k.b >= 0) bodies.push_back(k.b);
+    }
+    EXPECT_GT(lanes, 0);
+    full += lanes == kGroupLanes;
+    std::sort(bodies.begin(), bodies.end());
+    EXPECT_EQ(std::adjacent_find(bodies.begin(), bodies.end()), bodies.end());
+  }
+  for (int n : seen) EXPECT_EQ(n, 1);
+  // the groups are nearly all full: a pile's contacts are mostly independent four by four
+  EXPECT_GT(full, 0.9 * double(grouped.groups.size()));
+
+  // bodies 0..2 owned, 3 the image of 0 and 4 of 1: 3-2 and 0-2 share body 0 through the
+  // image, and 1 against its image 4 is one body on both sides
+  std::vector<Body> bodies(5);
+  const double xs[5] = {0.0, 1.0, 2.0, 3.0, 1.95};
+  for (int k = 0; k < 5; ++k) {
+    bodies[k].mass = 1.0;
+    bodies[k].radius = 0.5;
+    bodies[k].x = Vec3(xs[k], 0.0, k == 4 ? 0.6 : 0.0);
+  }
+  std::vector<Contact> contacts{sphere_sphere_contact(bodies, 3, 2),
+                                sphere_sphere_contact(bodies, 2, 0),
+                                sphere_sphere_contact(bodies, 4, 1)};
+  for (Contact &c : contacts) c.compliance.fill(1e-12);
+  const ContactSystem ring(bodies, contacts, 6, SpookParams{}, 3);
+  const ContactGroups images = group_contacts(ring, {0, 1, 2, 0, 1});
+  EXPECT_EQ(images.singles, std::vector<int>{2});
+  ASSERT_EQ(images.groups.size(), 2u); // 3-2 and 2-0 apart
+  EXPECT_EQ(images.groups[0], (ContactGroup{0, -1, -1, -1}));
+  EXPECT_EQ(images.groups[1], (ContactGroup{1, -1, -1, -1}));
+}
+
+// A grouped sweep is a one-at-a-time sweep in the groups' order: from a cold start, three
+// sweeps of each agree to round-off (the grouped lanes use fused multiply-adds), with rows 6
+// (every cone) and rows 3; and both reach the converged reference.
+TEST(SweepGroups, AreGaussSeidelInTheGroupsOrder)
+{
+  if (!grouped_sweeps_available()) GTEST_SKIP() << "no AVX2 and FMA on this processor";
+  Problem pr = pile(200, 0.4);
+  pr.sys.set_friction(FrictionParams{0.4, 0.05, 0.02});
+  for (int rows : {6, 3}) {
+    SCOPED_TRACE(rows);
+    const Problem base = reordered(
+        pr.sys,
+        [&] {
+          std::vector<int> all(pr.sys.num_contacts());
+          std::iota(all.begin(), all.end(), 0);
+          return all;
+        }(),
+        rows);
+    const std::vector<int> order = group_order(group_contacts(base.sys, {}));
+    const Problem in_order = reordered(base.sys, order, rows);
+    const auto sweeps = [](const Problem &p, bool grouped, int count, double accuracy) {
+      PgsControl control{count, 0.0, count};
+      control.grouped = grouped;
+      control.accuracy = accuracy;
+      Vector lambda = Vector::Zero(p.sys.contact_dofs());
+      pgs(p.sys, serial_exchange(), Cones(p.sys), p.b, row_scales(p.sys), lambda, control);
+      return lambda;
+    };
+    const Vector grouped = sweeps(base, true, 3, 0.0);
+    const Vector one_by_one = sweeps(in_order, false, 3, 0.0);
+    Vector back(grouped.size());
+    for (std::size_t k = 0; k < order.size(); ++k)
+      back.segment(rows * Eigen::Index(order[k]), rows) =
+          one_by_one.segment(rows * Eigen::Index(k), rows);
+    EXPECT_GT(grouped.norm(), 0.0);
+    EXPECT_LT(rel_diff(grouped, back), 1e-12);
+    // and not the listed order's sweeps, which differ after the first group
+    EXPECT_GT(rel_diff(grouped, sweeps(base, false, 3, 0.0)), 1e-6);
+
+    const Reference ref = nonsmooth_reference(base.sys, Vector::Zero(base.sys.contact_dofs()));
+    ASSERT_TRUE(ref.confirmed());
+    const Vector converged = sweeps(base, true, 100000, 1e-11);
+    EXPECT_LT(step_accuracy(base.sys, converged, ref.lambda).velocity(), 1e-7);
+    EXPECT_LT(step_accuracy(base.sys, converged, ref.lambda).lambda_n, 1e-7);
+  }
 }
