@@ -143,7 +143,11 @@ LammpsExchange::~LammpsExchange()
 
 const std::vector<int> &LammpsExchange::ghost_owners() const
 {
-  if (ghost_owners_known_) return ghost_owners_;
+  // A forward comm: every process refreshes when any one must (a process whose atoms were not
+  // rebuilt keeps its owners, but the others' comm needs it; deciding alone deadlocked).
+  int known = ghost_owners_known_ ? 1 : 0;
+  MPI_Allreduce(MPI_IN_PLACE, &known, 1, MPI_INT, MPI_MIN, halo_comm_);
+  if (known) return ghost_owners_;
   resize_halo();
   const int nlocal = lmp_->atom->nlocal;
   for (int i = 0; i < nlocal; ++i) halo_[std::size_t(kValuesPerAtom) * i] = lmp_->comm->me;
