@@ -18,7 +18,7 @@ LAYERS = {
     1: ["material", "contact_model", "kernels", "contact_rows", "detection", "mesh",
         "contact_history"],
     2: ["spook", "operators", "fibres", "cones", "assembly", "system_io", "stress"],
-    3: ["solver_control", "preconditioner", "preconditioner_family", "krylov", "direct", "pgs",
+    3: ["solver_control", "preconditioner", "preconditioner_family", "krylov", "direct", "pgs", "sweep_groups",
         "fibre_blocks", "apgd", "spectra", "analysis", "combined_preconditioner",
         "nonsmooth_reference"],
     4: ["step_solver", "accuracy_study"],

@@ -400,11 +400,18 @@ PgsResult pgs(const ContactSystem &sys, const Exchange &ex, const Cones &cones, 
     blocks =
         std::make_unique<FibreBlocks>(sys, ex.local_owners(), cones, control.block_weight, &normal);
   }
-  // Four contacts at a time where the processor can (sweep_groups.hpp), for the full sweeps
-  // that are not split into colour phases
-  std::unique_ptr<GroupedSweep> grouped;
-  if (control.grouped && !coloured && !focus && nc > 0 && grouped_sweeps_available())
-    grouped = std::make_unique<GroupedSweep>(sys, cones, b, inv_mass, inv_scale, ex.local_owners());
+  // Four contacts at a time where the processor can (sweep_groups.hpp): the full sweeps, or
+  // each colour phase; not the focused sweeps' lists
+  std::vector<std::unique_ptr<GroupedSweep>> grouped;
+  if (control.grouped && !focus && grouped_sweeps_available()) {
+    if (coloured)
+      for (const std::vector<int> &phase : phases)
+        grouped.push_back(std::make_unique<GroupedSweep>(sys, cones, b, inv_mass, inv_scale,
+                                                         ex.local_owners(), &phase));
+    else
+      grouped.push_back(
+          std::make_unique<GroupedSweep>(sys, cones, b, inv_mass, inv_scale, ex.local_owners()));
+  }
   Anderson anderson(std::max(control.anderson, 1), ex);
   Vector steps(accelerate ? lambda.size() : 0);
   std::vector<double> contact_changes(focus ? nc : 0);
@@ -428,11 +435,11 @@ PgsResult pgs(const ContactSystem &sys, const Exchange &ex, const Cones &cones, 
     const bool mixing = accelerate && !plain && s + 1 >= control.min_sweeps;
     // Every process's updates on every body: the sum of the local changes, owners and ghosts
     // (each copy's change at the body's own mass); with colours after each colour's phase.
-    const auto sweep_and_sum = [&](const int *visit, int n) {
-      if (grouped && !visit) {
-        grouped->sweep(lambda, dv, norms, mixing ? steps.data() : nullptr);
-        visit = grouped->singles().data(); // then the rest one at a time
-        n = static_cast<int>(grouped->singles().size());
+    const auto sweep_and_sum = [&](const int *visit, int n, GroupedSweep *group) {
+      if (group) {
+        group->sweep(lambda, dv, norms, mixing ? steps.data() : nullptr);
+        visit = group->singles().data(); // then the rest one at a time
+        n = static_cast<int>(group->singles().size());
       }
       if (rows == 6)
         sweep<6>(sys, cones, b, inv_mass, inv_scale, ex.local_owners(), visit, n, lambda, dv, norms,
@@ -450,10 +457,11 @@ PgsResult pgs(const ContactSystem &sys, const Exchange &ex, const Cones &cones, 
     if (coloured) {
       for (std::size_t p = 0; p < phases.size(); ++p) {
         if (p > 0) dv_start = dv; // the first phase starts where the sweep does
-        sweep_and_sum(phases[p].data(), static_cast<int>(phases[p].size()));
+        sweep_and_sum(phases[p].data(), static_cast<int>(phases[p].size()),
+                      grouped.empty() ? nullptr : grouped[p].get());
       }
     } else {
-      sweep_and_sum(list, count);
+      sweep_and_sum(list, count, grouped.empty() || list ? nullptr : grouped[0].get());
     }
     if (changes) focus_list(contact_changes, norms[0], focus_contacts);
     res.visits += count;

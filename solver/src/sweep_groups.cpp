@@ -11,7 +11,8 @@
 
 namespace fibre {
 
-ContactGroups group_contacts(const ContactSystem &sys, const std::vector<int> &owners)
+ContactGroups group_contacts(const ContactSystem &sys, const std::vector<int> &owners,
+                             const std::vector<int> *list)
 {
   constexpr int kOpen = 16; // open groups at most: a bit each in a body's mask
   const int nc = sys.num_contacts();
@@ -40,7 +41,9 @@ ContactGroups group_contacts(const ContactSystem &sys, const std::vector<int> &o
     }
     used &= ~(1u << slot);
   };
-  for (int c = 0; c < nc; ++c) {
+  const int count = list ? static_cast<int>(list->size()) : nc;
+  for (int k = 0; k < count; ++k) {
+    const int c = list ? (*list)[k] : k;
     const int a = owner(pairs[2 * c]), b = owner(pairs[2 * c + 1]);
     if (a == b) {
       out.singles.push_back(c);
@@ -82,10 +85,10 @@ enum : int {
 
 GroupedSweep::GroupedSweep(const ContactSystem &sys, const Cones &cones, const Vector &b,
                            const double *inv_mass, const std::vector<Vec6> &inv_scale,
-                           const std::vector<int> &owners)
+                           const std::vector<int> &owners, const std::vector<int> *list)
     : rows_(sys.rows())
 {
-  ContactGroups grouped = group_contacts(sys, owners);
+  ContactGroups grouped = group_contacts(sys, owners, list);
   singles_ = std::move(grouped.singles);
   const std::size_t lanes = grouped.groups.size() * kGroupLanes;
   contact_.assign(lanes, -1);

@@ -34,10 +34,12 @@ StepOptions sweeps_only(Method m, int sweeps)
 }
 
 // The defaults before session 11, with which the shipped state was exported: the tree-CG pass
-// and at most 50 sweeps, no step accuracy, every sweep full.
+// and at most 50 sweeps, no step accuracy, every sweep full, one contact at a time.
 StepOptions former_default()
 {
-  return parse_settings({"solver", "cg", "tol", "none", "focus_sweeps", "0", "anderson", "0"}).step;
+  return parse_settings({"solver", "cg", "tol", "none", "focus_sweeps", "0", "anderson", "0",
+                         "sweep_groups", "no"})
+      .step;
 }
 
 } // namespace

@@ -27,20 +27,23 @@ struct ContactGroups {
 // The contacts in groups, in their order: each joins the oldest of at most 16 open groups
 // that holds neither of its bodies (a periodic image counts as its body, `owners` as
 // Exchange::local_owners), and a group leaves when full or when a seventeenth is needed.
-// Every contact is in exactly one group or in `singles`.
-ContactGroups group_contacts(const ContactSystem &sys, const std::vector<int> &owners);
+// Every contact (of `list`, in its order, where given) is in exactly one group or in
+// `singles`.
+ContactGroups group_contacts(const ContactSystem &sys, const std::vector<int> &owners,
+                             const std::vector<int> *list = nullptr);
 
 // Whether this build and processor run the grouped sweeps (x86-64 with AVX2 and FMA).
 bool grouped_sweeps_available();
 
 // The groups' data for the sweeps of one solve, packed lane by lane (each of a contact's
 // numbers is one vector load): the rows of G, b, Sigma, the inverse row scales, the cones'
-// coefficients and the bodies' inverse masses. Only where grouped_sweeps_available().
+// coefficients and the bodies' inverse masses. Only where grouped_sweeps_available(). With
+// `list`, the sweeps visit those contacts only (a colour phase of pgs.cpp).
 class GroupedSweep {
  public:
   GroupedSweep(const ContactSystem &sys, const Cones &cones, const Vector &b,
                const double *inv_mass, const std::vector<Vec6> &inv_scale,
-               const std::vector<int> &owners);
+               const std::vector<int> &owners, const std::vector<int> *list = nullptr);
   // One sweep over the groups, as pgs.cpp's sweep over the same contacts one at a time:
   // lambda and dv updated, ||change||^2 and ||lambda||^2 added to norms, and with `steps` each
   // contact's change stored there. The singles are not swept here.
