@@ -44,6 +44,15 @@ class Reader {
     return value;
   }
 
+  // yes or no, as `key yes|no`
+  bool yes_no(std::size_t i, const std::string &key) const
+  {
+    const std::string expected = "'" + key + " yes|no'";
+    if (!has(i) || (args_[i] != "yes" && args_[i] != "no"))
+      illegal(expected, has(i) ? &args_[i] : nullptr);
+    return args_[i] == "yes";
+  }
+
   template <class E> E name(std::size_t i, const std::string &key) const
   {
     const std::string expected = "'" + key + " " + choices<E>() + "'";
@@ -158,19 +167,13 @@ std::size_t read_solver_keyword(const Reader &in, std::size_t i, StepOptions &op
   else if (key == "anderson") {
     opt.anderson = static_cast<int>(in.integer(i + 1, "'anderson <integer 0 to 50>'", 0, 50));
     anderson_typed = true;
-  } else if (key == "sweep_cg") {
-    if (!in.has(i + 1) || (in.at(i + 1) != "yes" && in.at(i + 1) != "no"))
-      Reader::illegal("'sweep_cg yes|no'", in.has(i + 1) ? &in.at(i + 1) : nullptr);
-    opt.sweep_cg = in.at(i + 1) == "yes";
-  } else if (key == "sweep_groups") {
-    if (!in.has(i + 1) || (in.at(i + 1) != "yes" && in.at(i + 1) != "no"))
-      Reader::illegal("'sweep_groups yes|no'", in.has(i + 1) ? &in.at(i + 1) : nullptr);
-    opt.sweep_groups = in.at(i + 1) == "yes";
-  } else if (key == "sweep_blocks") {
-    if (!in.has(i + 1) || (in.at(i + 1) != "yes" && in.at(i + 1) != "no"))
-      Reader::illegal("'sweep_blocks yes|no'", in.has(i + 1) ? &in.at(i + 1) : nullptr);
-    opt.sweep_blocks = in.at(i + 1) == "yes";
-  } else
+  } else if (key == "sweep_cg")
+    opt.sweep_cg = in.yes_no(i + 1, key);
+  else if (key == "sweep_groups")
+    opt.sweep_groups = in.yes_no(i + 1, key);
+  else if (key == "sweep_blocks")
+    opt.sweep_blocks = in.yes_no(i + 1, key);
+  else
     return 0;
   return 2;
 }

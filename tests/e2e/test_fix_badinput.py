@@ -64,6 +64,8 @@ CASES = [
     ("sweep_tol_zero", "sweep_tol 0", "expected 'sweep_tol <positive number>', got '0'", {}),
     ("sweep_tol_missing", "sweep_tol", "expected 'sweep_tol <positive number>'", {}),
     ("sweep_blocks_word", "sweep_blocks maybe", "expected 'sweep_blocks yes|no', got 'maybe'", {}),
+    ("sweep_groups_word", "sweep_groups 1", "expected 'sweep_groups yes|no', got '1'", {}),
+    ("sweep_groups_missing", "sweep_groups", "expected 'sweep_groups yes|no'", {}),
     ("maxiter_zero", "maxiter 0", "expected 'maxiter <positive integer>', got '0'", {}),
     ("maxiter_real", "maxiter 2.5", "expected 'maxiter <positive integer>', got '2.5'", {}),
     ("compliance_one", "compliance 1e-6",

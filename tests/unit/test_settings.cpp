@@ -118,6 +118,11 @@ TEST(Settings, EveryKeywordSetsWhatItNames)
   EXPECT_TRUE(blocks.step.sweep_blocks);
   EXPECT_NE(describe(blocks.step).find("sweep_blocks yes"), std::string::npos);
   EXPECT_FALSE(parse_settings(words("sweep_blocks no")).step.sweep_blocks);
+  EXPECT_TRUE(parse_settings({}).step.sweep_groups);
+  const Settings one_by_one = parse_settings(words("sweep_groups no"));
+  EXPECT_FALSE(one_by_one.step.sweep_groups);
+  EXPECT_NE(describe(one_by_one.step).find("sweep_groups no"), std::string::npos);
+  EXPECT_EQ(describe(parse_settings(words("sweep_groups yes")).step), describe(StepOptions{}));
   EXPECT_EQ(parse_settings(words("rescue_sweeps 0")).step.rescue_sweeps, 0);
   EXPECT_EQ(parse_settings(words("rescue_sweeps 2000")).step.rescue_sweeps, 2000);
   EXPECT_EQ(parse_settings(words("min_sweeps 0")).step.min_sweeps, 0);

@@ -44,8 +44,8 @@ struct PgsControl {
   // settled stiff pile the sweeps' error lies in a few slow modes of the whole pile, which the
   // combination removes together. Not with focused sweeps, nonlinear CG or fibre blocks.
   int anderson = 0;
-  // Full sweeps four contacts at a time (sweep_groups.hpp) where the processor has AVX2 and
-  // FMA and the sweep is not split into colour phases (processes that share bodies).
+  // Sweeps four contacts at a time (sweep_groups.hpp) where the processor has AVX2 and FMA:
+  // the full sweeps and each colour phase, not the focused sweeps' lists.
   bool grouped = true;
   double accuracy = 0; // the error-estimate rule (0: off)
   // The error-estimate rule stops no sooner than this: a rule met before stops the sweeps
