@@ -198,6 +198,26 @@ template <int R> FIBRE_AVX2 void store_rows(double *const p[4], const __m256d *v
     store_lanes3(p, v);
 }
 
+// t = v + omega x r: the velocity of a body's point at lever r (w: the body's six velocities).
+FIBRE_AVX2 void point_velocity(const __m256d w[6], const __m256d r[3], __m256d t[3])
+{
+  t[0] = _mm256_fmsub_pd(w[4], r[2], _mm256_fmsub_pd(w[5], r[1], w[0]));
+  t[1] = _mm256_fmsub_pd(w[5], r[0], _mm256_fmsub_pd(w[3], r[2], w[1]));
+  t[2] = _mm256_fmsub_pd(w[3], r[1], _mm256_fmsub_pd(w[4], r[0], w[2]));
+}
+
+// y = [f; r x f + m]: an impulse f and moment m at lever r on a body (contact_impulse).
+FIBRE_AVX2 void body_impulse(const __m256d r[3], const __m256d f[3], const __m256d m[3],
+                             __m256d y[6])
+{
+  y[0] = f[0];
+  y[1] = f[1];
+  y[2] = f[2];
+  y[3] = _mm256_add_pd(_mm256_fmsub_pd(r[1], f[2], _mm256_mul_pd(r[2], f[1])), m[0]);
+  y[4] = _mm256_add_pd(_mm256_fmsub_pd(r[2], f[0], _mm256_mul_pd(r[0], f[2])), m[1]);
+  y[5] = _mm256_add_pd(_mm256_fmsub_pd(r[0], f[1], _mm256_mul_pd(r[1], f[0])), m[2]);
+}
+
 // The sweep over the groups (pgs.cpp's sweep<R>, four contacts a step). An empty lane reads
 // and writes zeros in `spare` (its packed data is zero); a wall's side reads and writes the
 // spare body (its inverse mass is zero).
@@ -226,15 +246,14 @@ sweep_groups(const double *pack, const int *contact, const int *body_a, const in
     V va[6], vb[6];
     load_lanes6(wa, va);
     load_lanes6(wb, vb);
-    const V ra0 = FIBRE_FIELD(9), ra1 = FIBRE_FIELD(10), ra2 = FIBRE_FIELD(11);
-    const V rb0 = FIBRE_FIELD(12), rb1 = FIBRE_FIELD(13), rb2 = FIBRE_FIELD(14);
-    // t = v_a + omega_a x ra - v_b - omega_b x rb (contact_velocity)
-    V t0 = _mm256_fmsub_pd(va[4], ra2, _mm256_fmsub_pd(va[5], ra1, va[0]));
-    V t1 = _mm256_fmsub_pd(va[5], ra0, _mm256_fmsub_pd(va[3], ra2, va[1]));
-    V t2 = _mm256_fmsub_pd(va[3], ra1, _mm256_fmsub_pd(va[4], ra0, va[2]));
-    t0 = _mm256_sub_pd(t0, _mm256_fmsub_pd(vb[4], rb2, _mm256_fmsub_pd(vb[5], rb1, vb[0])));
-    t1 = _mm256_sub_pd(t1, _mm256_fmsub_pd(vb[5], rb0, _mm256_fmsub_pd(vb[3], rb2, vb[1])));
-    t2 = _mm256_sub_pd(t2, _mm256_fmsub_pd(vb[3], rb1, _mm256_fmsub_pd(vb[4], rb0, vb[2])));
+    const V ra[3] = {FIBRE_FIELD(9), FIBRE_FIELD(10), FIBRE_FIELD(11)};
+    const V rb[3] = {FIBRE_FIELD(12), FIBRE_FIELD(13), FIBRE_FIELD(14)};
+    // t = v_a + omega_a x ra - (v_b + omega_b x rb) (contact_velocity)
+    V ta[3], tb[3];
+    point_velocity(va, ra, ta);
+    point_velocity(vb, rb, tb);
+    const V t0 = _mm256_sub_pd(ta[0], tb[0]), t1 = _mm256_sub_pd(ta[1], tb[1]),
+            t2 = _mm256_sub_pd(ta[2], tb[2]);
     V D[9];
     for (int i = 0; i < 9; ++i) D[i] = FIBRE_FIELD(kFrame + i);
     V u[6];
@@ -292,18 +311,9 @@ sweep_groups(const double *pack, const int *contact, const int *body_a, const in
             D[3 * k + 2], delta[5],
             _mm256_fmadd_pd(D[3 * k + 1], delta[4], _mm256_mul_pd(D[3 * k], delta[3])));
     }
-    const V ya[6] = {f[0],
-                     f[1],
-                     f[2],
-                     _mm256_add_pd(_mm256_fmsub_pd(ra1, f[2], _mm256_mul_pd(ra2, f[1])), m[0]),
-                     _mm256_add_pd(_mm256_fmsub_pd(ra2, f[0], _mm256_mul_pd(ra0, f[2])), m[1]),
-                     _mm256_add_pd(_mm256_fmsub_pd(ra0, f[1], _mm256_mul_pd(ra1, f[0])), m[2])};
-    const V yb[6] = {f[0],
-                     f[1],
-                     f[2],
-                     _mm256_add_pd(_mm256_fmsub_pd(rb1, f[2], _mm256_mul_pd(rb2, f[1])), m[0]),
-                     _mm256_add_pd(_mm256_fmsub_pd(rb2, f[0], _mm256_mul_pd(rb0, f[2])), m[1]),
-                     _mm256_add_pd(_mm256_fmsub_pd(rb0, f[1], _mm256_mul_pd(rb1, f[0])), m[2])};
+    V ya[6], yb[6];
+    body_impulse(ra, f, m, ya);
+    body_impulse(rb, f, m, yb);
     for (int d = 0; d < 6; ++d) {
       va[d] = _mm256_fmadd_pd(FIBRE_FIELD(kMassA + d), ya[d], va[d]);
       vb[d] = _mm256_fnmadd_pd(FIBRE_FIELD(kMassB + d), yb[d], vb[d]);
