@@ -461,7 +461,7 @@ PgsResult pgs(const ContactSystem &sys, const Exchange &ex, const Cones &cones, 
                       grouped.empty() ? nullptr : grouped[p].get());
       }
     } else {
-      sweep_and_sum(list, count, grouped.empty() || list ? nullptr : grouped[0].get());
+      sweep_and_sum(list, count, grouped.empty() ? nullptr : grouped[0].get()); // no list then
     }
     if (changes) focus_list(contact_changes, norms[0], focus_contacts);
     res.visits += count;

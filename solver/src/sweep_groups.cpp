@@ -11,13 +11,23 @@
 
 namespace fibre {
 
+namespace {
+
+// The body that holds a body's velocity: itself, or a periodic image's body; -1 (a wall) stays.
+int owner_of(const std::vector<int> &owners, int body)
+{
+  return owners.empty() || body < 0 ? body : owners[body];
+}
+
+} // namespace
+
 ContactGroups group_contacts(const ContactSystem &sys, const std::vector<int> &owners,
                              const std::vector<int> *list)
 {
   constexpr int kOpen = 16; // open groups at most: a bit each in a body's mask
   const int nc = sys.num_contacts();
   const int *pairs = sys.body_pairs();
-  const auto owner = [&](int body) { return owners.empty() || body < 0 ? body : owners[body]; };
+  const auto owner = [&](int body) { return owner_of(owners, body); };
   std::vector<std::uint32_t> holding(sys.num_bodies(), 0); // per body: the open groups with it
   std::array<ContactGroup, kOpen> open{};
   std::array<int, kOpen> filled{}, opened{};
@@ -96,7 +106,7 @@ GroupedSweep::GroupedSweep(const ContactSystem &sys, const Cones &cones, const V
   body_b_.assign(lanes, -1);
   pack_.assign(grouped.groups.size() * kFields * kGroupLanes, 0.0);
   const int *pairs = sys.body_pairs();
-  const auto owner = [&](int body) { return owners.empty() || body < 0 ? body : owners[body]; };
+  const auto owner = [&](int body) { return owner_of(owners, body); };
   const double *sigma = sys.sigma().data();
   const std::size_t R = std::size_t(rows_);
   for (std::size_t lane = 0; lane < lanes; ++lane) {

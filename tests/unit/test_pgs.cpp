@@ -533,14 +533,9 @@ TEST(SweepGroups, AreGaussSeidelInTheGroupsOrder)
   pr.sys.set_friction(FrictionParams{0.4, 0.05, 0.02});
   for (int rows : {6, 3}) {
     SCOPED_TRACE(rows);
-    const Problem base = reordered(
-        pr.sys,
-        [&] {
-          std::vector<int> all(pr.sys.num_contacts());
-          std::iota(all.begin(), all.end(), 0);
-          return all;
-        }(),
-        rows);
+    std::vector<int> listed(pr.sys.num_contacts());
+    std::iota(listed.begin(), listed.end(), 0);
+    const Problem base = reordered(pr.sys, listed, rows);
     const std::vector<int> order = group_order(group_contacts(base.sys, {}));
     const Problem in_order = reordered(base.sys, order, rows);
     const auto sweeps = [](const Problem &p, bool grouped, int count, double accuracy) {
