@@ -41,7 +41,7 @@ double PgsResult::error_estimate() const
   // within plain sweeps'.
   if (singular_value >= 0)
     return std::isfinite(singular_value) && singular_value > 0
-               ? kAndersonSafety * last_change / singular_value
+               ? kAndersonSafety * mixed_change / singular_value
                : INFINITY;
   if (!(contraction < 1)) return INFINITY;
   return last_change * contraction / (1 - contraction);
@@ -52,13 +52,12 @@ namespace {
 // One sweep over the contacts `list` (in order; all of them when null, else `count`): each
 // moves to lambda_c + (b_c - G_c dv - Sigma_c lambda_c) / scale_c and is projected, and dv
 // follows at once. Adds ||change||^2 and ||lambda||^2 (local) of the contacts it visits to
-// norms; with `changes`, it stores each one's change^2 there, and with `steps` its change
-// (rows per contact; a full sweep only). The rows of G are applied in
+// norms; with `changes`, it stores each one's change^2 there. The rows of G are applied in
 // their structured form (contact_rows.hpp).
 template <int R>
 void sweep(const ContactSystem &sys, const Cones &cones, const Vector &b, const double *inv_mass,
            const std::vector<Vec6> &inv_scale, const std::vector<int> &owners, const int *list,
-           int count, Vector &lambda, Vector &dv, double norms[2], double *changes, double *steps)
+           int count, Vector &lambda, Vector &dv, double norms[2], double *changes)
 {
   const int *pairs = sys.body_pairs();
   const double *kin = sys.num_contacts() > 0 ? sys.kinematics(0).frame.data() : nullptr;
@@ -90,8 +89,6 @@ void sweep(const ContactSystem &sys, const Cones &cones, const Vector &b, const 
     }
     norms[0] += change2;
     if (changes) changes[c] = change2;
-    if (steps)
-      for (int i = 0; i < R; ++i) steps[at + i] = delta[i];
     if (change2 == 0) continue; // an open contact that stays open moves no body
     double ya[6] = {0, 0, 0, 0, 0, 0}, yb[6] = {0, 0, 0, 0, 0, 0};
     contact_impulse<R>(q, q + 9, q + 12, delta, ya, wb ? yb : nullptr);
@@ -160,63 +157,92 @@ void focus_list(const std::vector<double> &changes, double total, std::vector<in
     if (changes[c] >= floor) list.push_back(static_cast<int>(c));
 }
 
-// Anderson acceleration of the sweeps (PgsControl::anderson). The sweep from x gives g = G(x)
-// and f = g - x (its steps); with the differences dF, dG of the last `memory` pairs (f, g), the
-// next start is g - dG gamma, gamma = argmin |f - dF gamma|. dv is linear in lambda, so the
-// start's velocities combine the same way from the stored differences of the sweeps' dv. The
-// Gram matrix dF^T dF and dF^T f are kept up to date with one new column a sweep.
+// Anderson acceleration of the sweeps (PgsControl::anderson). The sweeps from the start x
+// (PgsControl::anderson_period of them) give g = G(x) and f = g - x; with the differences dF,
+// dG of the last `memory` pairs (f, g), the next start is g - dG gamma, gamma = argmin
+// |f - dF gamma|. dv is linear in lambda, so the start's velocities combine the same way from
+// the stored differences of the sweeps' dv. The Gram matrix dF^T dF and dF^T f are kept up to
+// date with one new column a mix.
 class Anderson {
  public:
   Anderson(int memory, const Exchange &ex) : memory_(memory), ex_(ex) {}
 
-  // `steps` = f and `lambda`, `dv` = g and its velocities; on return lambda and dv hold the
-  // next start. Returns the smallest ratio |dF_i| / |dX_i| over the history (dX the
-  // differences of the starts): near the solution dF = (J - I) dX, so it estimates the
-  // smallest singular value of I - J, and g's error is about |f| over it (infinite without a
-  // history: the next start is then g).
-  double mix(Vector &steps, Vector &lambda, Vector &dv)
+  // The start of the sweeps that the next mix combines (the mixes set it after the first).
+  bool has_start() const { return has_start_; }
+  void start(const Vector &lambda)
+  {
+    x_ = lambda;
+    has_start_ = true;
+  }
+
+  // `lambda`, `dv` = g and its velocities; on return they hold the next start. Returns the
+  // smallest ratio |dF_i| / |dX_i| over the history (dX the differences of the starts): near
+  // the solution dF = (J - I) dX, so it estimates the smallest singular value of I - J, and
+  // g's error is about |f| over it (infinite without a history: the next start is then g).
+  double mix(Vector &lambda, Vector &dv)
   {
     const Eigen::Index n = lambda.size();
-    if (!started_) { // the first sweep, or after a restart (every process alike: a process
-                     // without contacts takes part in the sums below)
+    const bool first = !started_;
+    int j = -1; // the new column
+    if (!first) {
+      j = newest_ = (newest_ + 1) % memory_; // the oldest column gives way
+      if (count_ < memory_) {
+        ++count_;
+        dF_.resize(count_), dG_.resize(count_), dDV_.resize(count_), dX2_.resize(count_);
+      }
+      dF_[j].resize(n), dG_[j].resize(n);
+    } else { // the first mix, or after a restart (every process alike: a process without
+             // contacts takes part in the sums below)
       started_ = true;
-      f_prev_.swap(steps);
-      steps.resize(n);
-      g_prev_ = lambda;
-      dv_prev_ = dv;
-      combined_ = false;
-      return sigma_;
+      f_prev_.resize(n);
+      g_prev_.resize(n);
     }
-    const int j = newest_ = (newest_ + 1) % memory_; // the oldest column gives way
-    if (count_ < memory_) {
-      ++count_;
-      dF_.resize(count_), dG_.resize(count_), dDV_.resize(count_), dX2_.resize(count_);
-    }
-    dF_[j].resize(n), dG_[j].resize(n);
-    // One pass in blocks that stay in cache: the new columns dF_j, dG_j, then dF_j . f_prev,
-    // |dX_j|^2 (dX = dG - dF) and the Gram matrix's new column dF_i . dF_j. The dot products
-    // and the copies are Eigen's (vectorized, several accumulators): a plain loop's single
-    // running sum is a chain of dependent adds, and its possible aliasing kept it scalar.
+    // One pass in blocks that stay in cache: f = g - x, and after the first mix the new
+    // columns dF_j, dG_j, then dF_j . f_prev, |dX_j|^2 (dX = dG - dF) and the Gram matrix's new
+    // column dF_i . dF_j; |f|^2 and |g|^2 always. The dot products and the copies are Eigen's
+    // (vectorized, several accumulators): a plain loop's single running sum is a chain of
+    // dependent adds, and its possible aliasing kept it scalar.
     std::vector<double> &dots = dots_;
-    dots.assign(count_ + 2, 0.0);
+    dots.assign(count_ + 4, 0.0);
+    double *f2 = &dots[count_ + 2], *g2 = &dots[count_ + 3];
     columns(dF_);
-    double *df = dF_[j].data(), *dg = dG_[j].data(), *fp = f_prev_.data(), *gp = g_prev_.data();
-    const double *st = steps.data(), *l = lambda.data();
+    double *fp = f_prev_.data(), *gp = g_prev_.data();
+    const double *l = lambda.data(), *x = x_.data();
     for (Eigen::Index e0 = 0; e0 < n; e0 += kBlock) {
       const Eigen::Index len = std::min(n - e0, kBlock);
       const ConstMap l_block(l + e0, len);
-      Map(df + e0, len) = ConstMap(st + e0, len) - ConstMap(fp + e0, len);
-      Map(dg + e0, len) = l_block - ConstMap(gp + e0, len);
+      Map f_block(f_.data(), len);
+      f_block = l_block - ConstMap(x + e0, len);
+      *f2 += f_block.squaredNorm();
+      *g2 += l_block.squaredNorm();
+      if (!first) {
+        double *df = dF_[j].data(), *dg = dG_[j].data();
+        Map(df + e0, len) = f_block - ConstMap(fp + e0, len);
+        Map(dg + e0, len) = l_block - ConstMap(gp + e0, len);
+        const ConstMap df_block(df + e0, len), dg_block(dg + e0, len);
+        dots[count_] += df_block.dot(ConstMap(fp + e0, len));
+        dots[count_ + 1] += (dg_block - df_block).squaredNorm();
+        for (int i = 0; i < count_; ++i) dots[i] += ConstMap(ptr_[i] + e0, len).dot(df_block);
+      }
+      Map(fp + e0, len) = f_block;
       Map(gp + e0, len) = l_block;
-      const ConstMap df_block(df + e0, len), dg_block(dg + e0, len);
-      dots[count_] += df_block.dot(ConstMap(fp + e0, len));
-      dots[count_ + 1] += (dg_block - df_block).squaredNorm();
-      for (int i = 0; i < count_; ++i) dots[i] += ConstMap(ptr_[i] + e0, len).dot(df_block);
     }
-    f_prev_.swap(steps);
-    dDV_[j] = dv - dv_prev_;
-    dv_prev_ = dv;
-    ex_.sum(dots.data(), count_ + 2);
+    ex_.sum(dots.data(), count_ + 4);
+    // A mix whose change exceeds the last one's crossed a kink of the cones (the sliding or
+    // open set changed): the old differences describe another map, and kept they stall the
+    // combination (measured: changes stuck at 1e-5 on a forming stiff pile). The history
+    // starts again from this mix.
+    const double change = *g2 > 0 ? std::sqrt(*f2 / *g2) : 0.0;
+    const bool grew = change > change_;
+    change_ = change;
+    combined_ = false;
+    if (first || grew) {
+      count_ = 0;
+      newest_ = -1;
+      dv_prev_ = dv;
+      x_ = lambda; // the next start is g
+      return sigma_;
+    }
     // rhs_i = dF_i . f with f = f_prev + dF_j
     for (int i = 0; i < count_; ++i) {
       gram_(i, j) = gram_(j, i) = dots[i];
@@ -231,21 +257,25 @@ class Anderson {
     const Vector gamma =
         (h + shift * Eigen::MatrixXd::Identity(count_, count_)).ldlt().solve(rhs_.head(count_));
     combined_ = gamma.allFinite();
-    if (combined_) {
-      combine(dG_, gamma, lambda);
-      combine(dDV_, gamma, dv);
-    } else {
+    if (!combined_) {
       restart();
+      x_ = lambda;
+      return sigma_;
     }
+    // the velocities' new column dv - dv_prev in the same pass as their combination
+    dDV_[j].resize(dv.size());
+    combine(dDV_, gamma, dv, dv_prev_.data(), dDV_[j].data());
+    combine(dG_, gamma, lambda, nullptr, nullptr, x_.data());
     return sigma_;
   }
 
   // Whether the last mix combined: lambda is then not the last sweep's impulses.
   bool combined() const { return combined_; }
-  // The last sweep's impulses (g), feasible.
+  // The last mix's g (the sweeps' impulses, feasible) and its |f| / |g|.
   const Vector &sweep_result() const { return g_prev_; }
+  double change() const { return change_; }
 
-  // Forget the history (the next sweep is plain).
+  // Forget the history (the next mix starts a new one; the start stays).
   void restart()
   {
     count_ = 0;
@@ -261,18 +291,26 @@ class Anderson {
     ptr_.resize(count_);
     for (int i = 0; i < count_; ++i) ptr_[i] = v[i].data();
   }
-  // y -= sum_i gamma_i v_i in one pass
-  void combine(const std::vector<Vector> &v, const Vector &gamma, Vector &y)
+  // y -= sum_i gamma_i v_i in one pass; with `previous`, first the newest column
+  // v_newest = y - previous and previous = y; with `copy`, copy = the result
+  void combine(const std::vector<Vector> &v, const Vector &gamma, Vector &y, double *previous,
+               double *newest, double *copy = nullptr)
   {
     columns(v);
     double *out = y.data();
     const Eigen::Index n = y.size();
     for (Eigen::Index e0 = 0; e0 < n; e0 += kBlock) { // a block of y stays in cache
       const Eigen::Index e1 = std::min(n, e0 + kBlock);
+      if (previous)
+        for (Eigen::Index e = e0; e < e1; ++e) {
+          newest[e] = out[e] - previous[e];
+          previous[e] = out[e];
+        }
       for (int i = 0; i < count_; ++i) {
         const double *p = ptr_[i], gi = gamma[i];
         for (Eigen::Index e = e0; e < e1; ++e) out[e] -= gi * p[e];
       }
+      if (copy) std::copy(out + e0, out + e1, copy + e0);
     }
   }
 
@@ -283,11 +321,13 @@ class Anderson {
   const Exchange &ex_;
   std::vector<const double *> ptr_;
   int count_ = 0, newest_ = -1;
-  double sigma_ = INFINITY; // the smallest over the whole solve: restarts keep it
-  bool combined_ = false, started_ = false;
+  double sigma_ = INFINITY;  // the smallest over the whole solve: restarts keep it
+  double change_ = INFINITY; // the last mix's |f| / |g|
+  bool combined_ = false, started_ = false, has_start_ = false;
   std::vector<Vector> dF_, dG_, dDV_;
   std::vector<double> dX2_, dots_;
-  Vector f_prev_, g_prev_, dv_prev_;
+  Vector x_, f_prev_, g_prev_, dv_prev_;
+  Vector f_ = Vector(kBlock);
   Eigen::MatrixXd gram_ = Eigen::MatrixXd::Zero(memory_, memory_);
   Vector rhs_ = Vector::Zero(memory_);
 };
@@ -413,7 +453,8 @@ PgsResult pgs(const ContactSystem &sys, const Exchange &ex, const Cones &cones, 
           std::make_unique<GroupedSweep>(sys, cones, b, inv_mass, inv_scale, ex.local_owners()));
   }
   Anderson anderson(std::max(control.anderson, 1), ex);
-  Vector steps(accelerate ? lambda.size() : 0);
+  const int period = std::max(control.anderson_period, 1);
+  bool combination = false; // lambda is Anderson's start, not a sweep's result
   std::vector<double> contact_changes(focus ? nc : 0);
   std::vector<int> focus_contacts;
   for (int s = 0; s < control.max_sweeps; ++s) {
@@ -424,29 +465,33 @@ PgsResult pgs(const ContactSystem &sys, const Exchange &ex, const Cones &cones, 
     double norms[2] = {0, 0}; // ||change||^2, ||lambda||^2
     // focused: the first sweep is full, then every (P + 1)-th counted from min_sweeps (so the
     // rules can stop where plain sweeps would); the P between visit the focus list
-    const int period = control.focus_sweeps + 1;
+    const int focus_period = control.focus_sweeps + 1;
     const bool full =
-        !focus || s == 0 || ((s + 1 - control.min_sweeps) % period + period) % period == 0;
+        !focus || s == 0 ||
+        ((s + 1 - control.min_sweeps) % focus_period + focus_period) % focus_period == 0;
     const int *list = full ? nullptr : focus_contacts.data();
     const int count = full ? nc : static_cast<int>(focus_contacts.size());
     double *changes = full && focus ? contact_changes.data() : nullptr;
     // Anderson: plain sweeps up to the floor (steps that it ends pay nothing), the history
-    // from its last sweep on
+    // from its last sweep on, a mix after every `period` sweeps
     const bool mixing = accelerate && !plain && s + 1 >= control.min_sweeps;
+    const bool mix = mixing && (s + 1 - control.min_sweeps) % period == period - 1;
+    if (mixing && !anderson.has_start()) anderson.start(lambda);
+    combination = false;
     // Every process's updates on every body: the sum of the local changes, owners and ghosts
     // (each copy's change at the body's own mass); with colours after each colour's phase.
     const auto sweep_and_sum = [&](const int *visit, int n, GroupedSweep *group) {
       if (group) {
-        group->sweep(lambda, dv, norms, mixing ? steps.data() : nullptr);
+        group->sweep(lambda, dv, norms);
         visit = group->singles().data(); // then the rest one at a time
         n = static_cast<int>(group->singles().size());
       }
       if (rows == 6)
         sweep<6>(sys, cones, b, inv_mass, inv_scale, ex.local_owners(), visit, n, lambda, dv, norms,
-                 changes, mixing ? steps.data() : nullptr);
+                 changes);
       else
         sweep<3>(sys, cones, b, inv_mass, inv_scale, ex.local_owners(), visit, n, lambda, dv, norms,
-                 changes, mixing ? steps.data() : nullptr);
+                 changes);
       if (halo) {
         moved = dv - dv_start;
         if (split.size()) moved.array() /= split.array();
@@ -480,13 +525,10 @@ PgsResult pgs(const ContactSystem &sys, const Exchange &ex, const Cones &cones, 
       lambda_best = lambda;
       have_best = true;
     }
-    if (mixing) {
-      // A sweep that moved lambda more than the one before crossed a kink of the cones (the
-      // sliding or open set changed): the old differences describe another map, and kept
-      // they stall the combination (measured: changes stuck at 1e-5 on a forming stiff pile).
-      const std::size_t k = res.changes.size();
-      if (k > 1 && res.changes[k - 1] > res.changes[k - 2]) anderson.restart();
-      res.singular_value = anderson.mix(steps, lambda, dv); // lambda: the next start
+    if (mix) {
+      res.singular_value = anderson.mix(lambda, dv); // lambda: the next start
+      res.mixed_change = anderson.change();
+      combination = anderson.combined();
     }
     res.reason = StopReason::max_iterations;
     // with a floor, a met estimate stops the sweeps at the floor: the changes of the sweeps
@@ -521,7 +563,8 @@ PgsResult pgs(const ContactSystem &sys, const Exchange &ex, const Cones &cones, 
       plain = true;
       anderson.restart();
       res.restart_rate(); // the estimate follows the plain sweeps' own contraction
-      if (have_best) {    // a collective: every process, with or without contacts
+      combination = false;
+      if (have_best) { // a collective: every process, with or without contacts
         lambda = lambda_best;
         dv = velocity_change(sys, ex, lambda);
       }
@@ -542,7 +585,7 @@ PgsResult pgs(const ContactSystem &sys, const Exchange &ex, const Cones &cones, 
       }
     }
   }
-  if (anderson.combined()) lambda = anderson.sweep_result();
+  if (combination) lambda = anderson.sweep_result();
   if (control.nonlinear_cg) // the last step along the direction may have left the cones
     for (int c = 0; c < nc; ++c) cones.project(lambda.data() + Eigen::Index(rows) * c, c);
   return res;

@@ -167,7 +167,10 @@ std::size_t read_solver_keyword(const Reader &in, std::size_t i, StepOptions &op
   else if (key == "anderson") {
     opt.anderson = static_cast<int>(in.integer(i + 1, "'anderson <integer 0 to 50>'", 0, 50));
     anderson_typed = true;
-  } else if (key == "sweep_cg")
+  } else if (key == "anderson_period")
+    opt.anderson_period =
+        static_cast<int>(in.integer(i + 1, "'anderson_period <integer 1 to 100>'", 1, 100));
+  else if (key == "sweep_cg")
     opt.sweep_cg = in.yes_no(i + 1, key);
   else if (key == "sweep_groups")
     opt.sweep_groups = in.yes_no(i + 1, key);
@@ -293,8 +296,9 @@ Settings parse_settings(const std::vector<std::string> &args)
       Reader::illegal(
           "a keyword (form, solver, precond, weight, tol, linear_tol, pass_tol, maxiter, "
           "compliance, damping, mu, mu_roll, mu_twist, rows, active_set, sweeps, "
-          "sweep_tol, rescue_sweeps, min_sweeps, focus_sweeps, anderson, sweep_cg, sweep_blocks, "
-          "sweep_groups, "
+          "sweep_tol, rescue_sweeps, min_sweeps, focus_sweeps, anderson, anderson_period, "
+          "sweep_cg, "
+          "sweep_blocks, sweep_groups, "
           "recovery_speed, restitution, bounce_speed, coefficients, normal_relaxation, wall, "
           "export)",
           &key);

@@ -24,8 +24,9 @@ std::string describe(const StepOptions &opt)
          ", sweeps " + std::to_string(opt.sweeps) + ", sweep_tol " + g(opt.sweep_tol) +
          ", rescue_sweeps " + std::to_string(opt.rescue_sweeps) + ", min_sweeps " +
          std::to_string(opt.min_sweeps) + ", focus_sweeps " + std::to_string(opt.focus_sweeps) +
-         ", anderson " + std::to_string(opt.anderson) + (opt.sweep_cg ? ", sweep_cg yes" : "") +
-         (opt.sweep_blocks ? ", sweep_blocks yes" : "") +
+         ", anderson " + std::to_string(opt.anderson) +
+         (opt.anderson > 0 ? ", anderson_period " + std::to_string(opt.anderson_period) : "") +
+         (opt.sweep_cg ? ", sweep_cg yes" : "") + (opt.sweep_blocks ? ", sweep_blocks yes" : "") +
          (opt.sweep_groups ? "" : ", sweep_groups no");
 }
 
@@ -292,6 +293,7 @@ void StepSolver::finish(Vector &lambda, StepResult &res) const
     control.min_sweeps = opt_.min_sweeps;
     control.focus_sweeps = opt_.focus_sweeps;
     control.anderson = opt_.anderson;
+    control.anderson_period = opt_.anderson_period;
     control.grouped = opt_.sweep_groups;
     control.nonlinear_cg = opt_.sweep_cg || opt_.solver == Method::nncg;
     control.fibre_blocks = opt_.sweep_blocks || opt_.solver == Method::fbgs;

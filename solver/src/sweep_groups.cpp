@@ -234,24 +234,22 @@ FIBRE_AVX2 void body_impulse(const __m256d r[3], const __m256d f[3], const __m25
 template <int R>
 __attribute__((target("avx2,fma"))) void
 sweep_groups(const double *pack, const int *contact, const int *body_a, const int *body_b,
-             int groups, double *l, double *w, double norms[2], double *steps)
+             int groups, double *l, double *w, double norms[2])
 {
   using V = __m256d;
-  alignas(32) double spare_body[6] = {0, 0, 0, 0, 0, 0}, spare_rows[6] = {0, 0, 0, 0, 0, 0},
-                     spare_steps[6];
+  alignas(32) double spare_body[6] = {0, 0, 0, 0, 0, 0}, spare_rows[6] = {0, 0, 0, 0, 0, 0};
   const V zero = _mm256_setzero_pd(), inf = _mm256_set1_pd(INFINITY), one = _mm256_set1_pd(1.0);
   V change2 = zero, size2 = zero;
   for (int g = 0; g < groups; ++g) {
     const double *p = pack + std::size_t(g) * kFields * kGroupLanes;
 #define FIBRE_FIELD(f) _mm256_loadu_pd(p + kGroupLanes * (f))
-    double *wa[4], *wb[4], *lc[4], *st[4];
+    double *wa[4], *wb[4], *lc[4];
     for (int j = 0; j < 4; ++j) {
       const std::size_t lane = std::size_t(g) * kGroupLanes + j;
       const int c = contact[lane];
       wa[j] = c >= 0 ? w + 6 * std::size_t(body_a[lane]) : spare_body;
       wb[j] = c >= 0 && body_b[lane] >= 0 ? w + 6 * std::size_t(body_b[lane]) : spare_body;
       lc[j] = c >= 0 ? l + std::size_t(R) * c : spare_rows;
-      st[j] = c >= 0 && steps ? steps + std::size_t(R) * c : spare_steps;
     }
     V va[6], vb[6];
     load_lanes6(wa, va);
@@ -308,7 +306,6 @@ sweep_groups(const double *pack, const int *contact, const int *body_a, const in
       size2 = _mm256_fmadd_pd(x[i], x[i], size2);
     }
     store_rows<R>(lc, x);
-    if (steps) store_rows<R>(st, delta);
     // G^T delta (contact_impulse): f = D^T delta_t, m = D^T delta_r; y_a = [f; ra x f + m],
     // y_b = -[f; rb x f + m]; then w += M^-1 y
     V f[3], m[3] = {zero, zero, zero};
@@ -343,15 +340,15 @@ sweep_groups(const double *pack, const int *contact, const int *body_a, const in
 
 } // namespace
 
-void GroupedSweep::sweep(Vector &lambda, Vector &dv, double norms[2], double *steps)
+void GroupedSweep::sweep(Vector &lambda, Vector &dv, double norms[2])
 {
   const int groups = static_cast<int>(contact_.size()) / kGroupLanes;
   if (rows_ == 6)
     sweep_groups<6>(pack_.data(), contact_.data(), body_a_.data(), body_b_.data(), groups,
-                    lambda.data(), dv.data(), norms, steps);
+                    lambda.data(), dv.data(), norms);
   else
     sweep_groups<3>(pack_.data(), contact_.data(), body_a_.data(), body_b_.data(), groups,
-                    lambda.data(), dv.data(), norms, steps);
+                    lambda.data(), dv.data(), norms);
 }
 
 #else
@@ -361,7 +358,7 @@ bool grouped_sweeps_available()
   return false;
 }
 
-void GroupedSweep::sweep(Vector &, Vector &, double *, double *)
+void GroupedSweep::sweep(Vector &, Vector &, double *)
 {
   throw std::logic_error("GroupedSweep::sweep: grouped sweeps need x86-64 with AVX2 and FMA");
 }

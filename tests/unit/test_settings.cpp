@@ -61,7 +61,7 @@ TEST(Settings, NoKeywordsKeepTheDefaults)
       describe(s),
       "form body, solver pgs, precond tree, weight z, tol 0.0001, linear_tol 0.0001, pass_tol "
       "0.001, maxiter 200, active_set 1, sweeps 2000, sweep_tol 0.001, rescue_sweeps 500, "
-      "min_sweeps 10, focus_sweeps 0, anderson 3, rows 6, damping 2, "
+      "min_sweeps 10, focus_sweeps 0, anderson 3, anderson_period 2, rows 6, damping 2, "
       "compliance auto "
       "(0.01 dt^2 / m_min), recovery_speed auto (0.01 r_min / dt), restitution 0, "
       "bounce_speed auto (2 dt |f| / m max, or 0.01 r_min / dt without forces), coefficients "
@@ -141,6 +141,13 @@ TEST(Settings, EveryKeywordSetsWhatItNames)
   EXPECT_EQ(parse_settings(words("solver cg")).step.anderson, 3);
   EXPECT_NE(describe(parse_settings(words("anderson 3")).step).find("anderson 3"),
             std::string::npos);
+  EXPECT_EQ(parse_settings(words("anderson_period 1")).step.anderson_period, 1);
+  EXPECT_EQ(parse_settings(words("anderson_period 3")).step.anderson_period, 3);
+  EXPECT_NE(describe(parse_settings(words("anderson_period 1")).step).find("anderson_period 1"),
+            std::string::npos);
+  // without Anderson its period means nothing
+  EXPECT_EQ(describe(parse_settings(words("anderson 0")).step).find("anderson_period"),
+            std::string::npos);
 }
 
 // Strict numbers: the whole word, finite; an underflow to a subnormal is a number, an overflow
@@ -210,6 +217,9 @@ TEST(Settings, BadInputNamesTheKeywordAndItsForm)
             "or 'wall mesh <fix-ID>', got 'cylinder'");
   EXPECT_EQ(error_of("export 10"), "expected 'export <N> <file-prefix>' (N a positive integer)");
   EXPECT_EQ(error_of("anderson 51"), "expected 'anderson <integer 0 to 50>', got '51'");
+  EXPECT_EQ(error_of("anderson_period 0"),
+            "expected 'anderson_period <integer 1 to 100>', got '0'");
+  EXPECT_EQ(error_of("anderson_period"), "expected 'anderson_period <integer 1 to 100>'");
   EXPECT_EQ(error_of("solver nncg anderson 3"),
             "anderson accelerates plain sweeps: not with solver nncg, apgd or fbgs, sweep_cg yes, "
             "sweep_blocks yes, or focus_sweeps");

@@ -44,6 +44,10 @@ struct PgsControl {
   // settled stiff pile the sweeps' error lies in a few slow modes of the whole pile, which the
   // combination removes together. Not with focused sweeps, nonlinear CG or fibre blocks.
   int anderson = 0;
+  // Anderson's map is this many sweeps: a mix after every anderson_period sweeps. A mix costs
+  // about a sweep's arithmetic; mixing every other sweep gave the same accuracy for less
+  // (doc/design.md, section 6).
+  int anderson_period = 1;
   // Sweeps four contacts at a time (sweep_groups.hpp) where the processor has AVX2 and FMA:
   // the full sweeps and each colour phase, not the focused sweeps' lists.
   bool grouped = true;
@@ -72,10 +76,13 @@ struct PgsResult {
   // about last_change * contraction / (1 - contraction): infinite while the changes do not
   // fall.
   double contraction = 1;
-  // Anderson acceleration: the estimate of I - J's smallest singular value (J the sweep's
-  // Jacobian) from the history, infinite without one; -1 without acceleration. The estimate
-  // is then kAndersonSafety * last_change / singular_value.
+  // Anderson acceleration: the estimate of I - J's smallest singular value (J the Jacobian of
+  // Anderson's map, PgsControl::anderson_period sweeps) from the history, infinite without
+  // one; -1 without acceleration. The estimate is then
+  // kAndersonSafety * mixed_change / singular_value, mixed_change the last mix's change over
+  // its sweeps relative to |lambda|.
   double singular_value = -1;
+  double mixed_change = 0;
   std::vector<double> changes;  // per sweep (iteration)
   std::vector<int> full_sweeps; // the full sweeps' indices in `changes`
   // One more sweep's change: changes follows, and for a full sweep (every plain one)

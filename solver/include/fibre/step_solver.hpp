@@ -79,6 +79,10 @@ struct StepOptions {
   // step (bench/README.md, "Anderson acceleration"). Plain sweeps only: solver nncg, apgd and
   // fbgs, sweep_cg, sweep_blocks and focus_sweeps turn it off unless it was typed.
   int anderson = 3;
+  // Anderson's map is this many sweeps (PgsControl::anderson_period): a mix after every second
+  // sweep costs half as much a sweep, and its solves reach the same errors against the
+  // converged step in the same sweeps (bench/README.md, "Anderson every other sweep").
+  int anderson_period = 2;
   // Full sweeps four contacts at a time, in groups that share no body (PgsControl::grouped,
   // sweep_groups.hpp; where the processor has AVX2 and FMA): the same sweeps in another order,
   // at half the time a sweep (bench/README.md, "Sweeps four contacts at a time").

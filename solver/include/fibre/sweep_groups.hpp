@@ -45,9 +45,9 @@ class GroupedSweep {
                const double *inv_mass, const std::vector<Vec6> &inv_scale,
                const std::vector<int> &owners, const std::vector<int> *list = nullptr);
   // One sweep over the groups, as pgs.cpp's sweep over the same contacts one at a time:
-  // lambda and dv updated, ||change||^2 and ||lambda||^2 added to norms, and with `steps` each
-  // contact's change stored there. The singles are not swept here.
-  void sweep(Vector &lambda, Vector &dv, double norms[2], double *steps);
+  // lambda and dv updated, ||change||^2 and ||lambda||^2 added to norms. The singles are not
+  // swept here.
+  void sweep(Vector &lambda, Vector &dv, double norms[2]);
   const std::vector<int> &singles() const { return singles_; }
 
  private:
