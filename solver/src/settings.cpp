@@ -297,10 +297,8 @@ Settings parse_settings(const std::vector<std::string> &args)
           "a keyword (form, solver, precond, weight, tol, linear_tol, pass_tol, maxiter, "
           "compliance, damping, mu, mu_roll, mu_twist, rows, active_set, sweeps, "
           "sweep_tol, rescue_sweeps, min_sweeps, focus_sweeps, anderson, anderson_period, "
-          "sweep_cg, "
-          "sweep_blocks, sweep_groups, "
-          "recovery_speed, restitution, bounce_speed, coefficients, normal_relaxation, wall, "
-          "export)",
+          "sweep_cg, sweep_blocks, sweep_groups, recovery_speed, restitution, bounce_speed, "
+          "coefficients, normal_relaxation, wall, export)",
           &key);
     i += used;
   }

@@ -45,8 +45,8 @@ struct PgsControl {
   // combination removes together. Not with focused sweeps, nonlinear CG or fibre blocks.
   int anderson = 0;
   // Anderson's map is this many sweeps: a mix after every anderson_period sweeps. A mix costs
-  // about a sweep's arithmetic; mixing every other sweep gave the same accuracy for less
-  // (doc/design.md, section 6).
+  // about as much as a sweep (its vectors are memory traffic); mixing after every other sweep
+  // gave the same accuracy for less (doc/design.md, section 6).
   int anderson_period = 1;
   // Sweeps four contacts at a time (sweep_groups.hpp) where the processor has AVX2 and FMA:
   // the full sweeps and each colour phase, not the focused sweeps' lists.

@@ -79,9 +79,9 @@ struct StepOptions {
   // step (bench/README.md, "Anderson acceleration"). Plain sweeps only: solver nncg, apgd and
   // fbgs, sweep_cg, sweep_blocks and focus_sweeps turn it off unless it was typed.
   int anderson = 3;
-  // Anderson's map is this many sweeps (PgsControl::anderson_period): a mix after every second
-  // sweep costs half as much a sweep, and its solves reach the same errors against the
-  // converged step in the same sweeps (bench/README.md, "Anderson every other sweep").
+  // Anderson's map is this many sweeps (PgsControl::anderson_period): with a mix after every
+  // second sweep a solve cost 0.68 to 0.90 of a mix after every sweep, at the same or smaller
+  // errors against the converged step (bench/README.md, "Anderson every other sweep").
   int anderson_period = 2;
   // Full sweeps four contacts at a time, in groups that share no body (PgsControl::grouped,
   // sweep_groups.hpp; where the processor has AVX2 and FMA): the same sweeps in another order,
