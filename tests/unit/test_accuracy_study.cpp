@@ -282,7 +282,7 @@ TEST(AccuracyStudy, StiffPileStepConvergesPastAThousandSweepsWithoutANewSmallest
   const double tk = k_product_seconds(st.sys, 5);
   const StudyRow def = measure_setting(st, parse_settings({}).step, ref.lambda, tk, 1);
   EXPECT_TRUE(def.converged);
-  EXPECT_GT(def.sweeps, 1385);
+  EXPECT_GT(def.sweeps, 1000); // 1,848 here, 1,849 one contact at a time
   EXPECT_LE(def.sweeps, 2000);
   EXPECT_LT(def.error.dv_trans, 1e-4);
   EXPECT_LT(def.error.dv_rot, 1e-3);
