@@ -10,14 +10,15 @@ usage() {  # script
 
 # The options of the end-to-end scripts, into the variables of the same name (the caller sets
 # the defaults first): --deck, --N, --tend, --np, --lmp, --work, --extra, --mpirun-flags
-# (mpirun_flags), --balance; -h/--help prints the caller's usage and exits 0, anything else exits 2.
+# (mpirun_flags), --balance, --vars, --native; -h/--help prints the caller's usage and exits 0,
+# anything else exits 2.
 parse_options() {  # script "$@"
   local script=$1
   shift
   while [ $# -gt 0 ]; do
     case $1 in
       -h|--help) usage "$script"; exit 0 ;;
-      --deck|--N|--tend|--np|--lmp|--work|--extra|--mpirun-flags|--balance)
+      --deck|--N|--tend|--np|--lmp|--work|--extra|--mpirun-flags|--balance|--vars|--native)
         [ $# -ge 2 ] || { echo "$(basename "$script"): $1 needs a value" >&2; exit 2; }
         case $1 in
           --deck) deck=$2 ;;
@@ -29,6 +30,8 @@ parse_options() {  # script "$@"
           --extra) extra=$2 ;;
           --mpirun-flags) mpirun_flags=$2 ;;
           --balance) balance=$2 ;;
+          --vars) vars=$2 ;;
+          --native) native=$2 ;;
         esac
         shift 2 ;;
       *) echo "$(basename "$script"): unknown option $1 (--help: the usage)" >&2; exit 2 ;;
