@@ -65,6 +65,8 @@ last_run() {  # log
   awk '/^Loop time of/ { keep = $9 > 0; if (keep) s = "" } keep { s = s $0 "\n" }
        END { printf "%s", s }' "$1"
 }
+loop_seconds() { sed -n 's/^Loop time of \([0-9.e+-]*\) on .*/\1/p' <<< "$1"; }  # last_run's text
+loop_steps() { sed -n 's/.* for \([0-9]*\) steps with .*/\1/p' <<< "$1"; }
 t1=""
 for np in $nps; do
   over=""
@@ -75,8 +77,8 @@ for np in $nps; do
     -var fc_extra "$extra" -log "$log" -screen none > "out.np$np" 2>&1 ||
     { echo "np $np failed, see $work/out.np$np"; continue; }
   last=$(last_run "$log")
-  loop=$(sed -n 's/^Loop time of \([0-9.e+-]*\) on .*/\1/p' <<< "$last")
-  steps=$(sed -n 's/.* for \([0-9]*\) steps with .*/\1/p' <<< "$last")
+  loop=$(loop_seconds "$last")
+  steps=$(loop_steps "$last")
   timing=$(sed -n 's/^fibre_timing setup_per_step \([^ ]*\) solve_per_step \([^ ]*\) sweep_per_step \([^ ]*\) sweeps_per_step \([^ ]*\)/\1 \2 \3 \4/p' "$log" | tail -1)
   pct() { awk -v k="$1" '$1 == k && $2 == "|" { print $NF }' <<< "$last" | tail -1; }
   [ -z "$t1" ] && t1=$loop && p1=$np
@@ -94,9 +96,7 @@ for np in $nps; do
     "${varargs[@]}" -log "native.$log" -screen none > "out.native.np$np" 2>&1 ||
     { echo "native np $np failed, see $work/out.native.np$np"; continue; }
   last=$(last_run "native.$log")
-  nloop=$(sed -n 's/^Loop time of \([0-9.e+-]*\) on .*/\1/p' <<< "$last")
-  nsteps=$(sed -n 's/.* for \([0-9]*\) steps with .*/\1/p' <<< "$last")
-  awk -v np="$np" -v n="$nloop" -v f="$loop" -v ns="$nsteps" 'BEGIN {
+  awk -v n="$(loop_seconds "$last")" -v f="$loop" -v ns="$(loop_steps "$last")" 'BEGIN {
     printf "     native: loop_s %.2f (%d steps), native / fix %.2f\n", n, ns, n / f }'
 done
 echo "eff = T(first) * np(first) / (np * T): parallel efficiency of the loop time"
