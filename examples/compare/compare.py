@@ -16,7 +16,7 @@ Subcommands (run from anywhere; paths default to this repository):
       for each method.
   compare.py seeds SCENE --N N --seeds S1 S2 ... [--run] [--jobs J] [--tag T]
                  [--var NAME VALUE] [--fibre-var NAME VALUE] [--native-var NAME VALUE]
-                 [--native-tag T0] [--against-tag T1]
+                 [--native-tag T0] [--against-tag T1] [--from-table FILE]
       both twins over several seeds of fix pour (one run directory per seed,
       WORKDIR/SCENE.N.T_sSEED; with --run: runs what is missing, J runs at a time), and per
       twin the mean, range and standard deviation of the heap's height and angle (material) or
@@ -27,7 +27,11 @@ Subcommands (run from anywhere; paths default to this repository):
       from (or run in) the directories of tag T0, so that several settings of the fix are
       set against one set of native runs. With --against-tag T1 the fix's runs are also
       paired by seed with the fix's runs of tag T1 (another setting of the fix, the same
-      seeds), and the table gains their difference.
+      seeds), and the table gains their difference. With --from-table FILE (a former seeds
+      table of this scene) native's figures are that table's and only the fix runs: a rerun
+      of the fix against native runs kept from an earlier session; the table gains the fix's
+      difference from the former table's fix, and its speed line is left out (the twins'
+      wall seconds are then of different machines).
   compare.py picture SCENE --N N [--method M] [--when last|filled|STEP] [--out DIR]
       a PNG snapshot of a run's dump (LAMMPS dump image, coloured by height), for the README.
 
@@ -606,11 +610,28 @@ def seed_figures(a, method, tag):
     return r
 
 
-def run_missing_seeds(a):
+def read_seeds_table(path, scene):
+    """A seeds table's figures (cmd_seeds' form): {method: {key: {seed: value}}}, NaN where the
+    table says clogged."""
+    figures = SEED_FIGURES[scene] + (WALL_FIGURE,)
+    values = {m: {key: {} for key, _, _, _ in figures} for m in METHODS}
+    for line in open(path):
+        cells = [c.strip() for c in line.strip().strip("|").split("|")]
+        if len(cells) != 1 + len(METHODS) * len(figures) or not cells[0].isdigit():
+            continue
+        for i, (m, (key, _, _, _)) in enumerate((m, f) for m in METHODS for f in figures):
+            text = cells[1 + i]
+            values[m][key][cells[0]] = float("nan") if text == "clogged" else float(text)
+    if not values["native"][figures[0][0]]:
+        die("%s: no seed rows of the %s scene" % (path, scene))
+    return values
+
+
+def run_missing_seeds(a, methods=METHODS):
     """Runs (with --run) each seed's twins that have no log yet, a.jobs at a time."""
     jobs = []
     for seed in a.seeds:
-        for m in METHODS:
+        for m in methods:
             tag = seed_tag(a, seed, m)
             own = a.fibre_var if m == "fibre" else a.native_var
             logp = os.path.join(run_dir(a.workdir, a.scene, a.N, tag),
@@ -628,7 +649,12 @@ def run_missing_seeds(a):
 
 
 def cmd_seeds(a):
-    run_missing_seeds(a)
+    former = read_seeds_table(a.from_table, a.scene) if a.from_table else None
+    if former:
+        missing = [s for s in a.seeds if s not in former["native"][WALL_FIGURE[0]]]
+        if missing:
+            die("--from-table %s has no row for seeds %s" % (a.from_table, " ".join(missing)))
+    run_missing_seeds(a, ("fibre",) if former else METHODS)
     figures = SEED_FIGURES[a.scene] + (WALL_FIGURE,)
     values = {m: {key: {} for key, _, _, _ in figures} for m in METHODS}  # seed -> value
     clogs = {m: [] for m in METHODS}
@@ -636,7 +662,11 @@ def cmd_seeds(a):
     for seed in a.seeds:
         cells = []
         for m in METHODS:
-            r = seed_figures(a, m, seed_tag(a, seed, m))
+            if former and m == "native":
+                r = {key: former[m][key][seed] for key, _, _, _ in figures}
+                r["clogged"] = a.scene == "silo" and not math.isfinite(r["rate"])
+            else:
+                r = seed_figures(a, m, seed_tag(a, seed, m))
             if a.scene == "silo" and r["clogged"]:
                 clogs[m].append(seed)
             for key, _, fmt, _ in figures:
@@ -665,31 +695,39 @@ def cmd_seeds(a):
     def twin(t, fmt):
         return "%s (%s..%s), %s, %d seeds" % (fmt % t["mean"], fmt % t["min"], fmt % t["max"],
                                               fmt % t["sd"], t["n"])
-    for key, label, fmt, relative in figures:
+    # with --from-table the twins' wall seconds are of different machines: not compared
+    compared = [f for f in figures if not (former and f is WALL_FIGURE)]
+    for key, label, fmt, relative in compared:
         st = paired_stats(values["fibre"][key], values["native"][key])
         lines.append("| %s | %s | %s | %s over %d seeds | %s |" % (
             label, twin(st["native"], fmt), twin(st["fibre"], fmt),
             difference(st, fmt, relative), st["paired"], difference(st, fmt, relative, True)))
-    # a twin's runs of another setting, read as they are (no --run)
-    for m, who, prefix in (("fibre", "fix", a.against_tag),
-                           ("native", "native", a.native_against_tag)):
-        if not prefix:
-            continue
+    # a twin's runs of another setting, read as they are (no --run), or the former table's fix
+    againsts = [(m, who, prefix, None) for m, who, prefix in (
+        ("fibre", "fix", a.against_tag), ("native", "native", a.native_against_tag)) if prefix]
+    if former:
+        againsts.append(("fibre", "fix", os.path.basename(a.from_table), former["fibre"]))
+    for m, who, prefix, table in againsts:
         other = {key: {} for key, _, _, _ in figures}
         for seed in a.seeds:
-            r = seed_figures(a, m, seed_tag(a, seed, prefix=prefix))
+            r = ({key: table[key][seed] for key in other} if table
+                 else seed_figures(a, m, seed_tag(a, seed, prefix=prefix)))
             for key, _, _, _ in figures:
                 other[key][seed] = r[key]
         lines += ["", "| figure | %s (%s) - %s (%s), paired by seed (standard error) | the means "
                   "(standard error) |" % (who, run_prefix(a, m), who, prefix), "|---|---|---|"]
-        for key, label, fmt, relative in figures:
+        for key, label, fmt, relative in compared:
             st = paired_stats(values[m][key], other[key])
             lines.append("| %s | %s over %d seeds | %s |" % (
                 label, difference(st, fmt, relative), st["paired"],
                 difference(st, fmt, relative, True)))
     wall = {m: np.mean(list(values[m]["wall_per_s"].values())) for m in METHODS}
-    lines += ["", "Speed: native / fix = %.2fx (mean wall seconds per simulated second)."
-              % (wall["native"] / wall["fibre"])]
+    if former:
+        lines += ["", "Native's figures and wall seconds are those of `%s`, so no speed ratio."
+                  % os.path.basename(a.from_table)]
+    else:
+        lines += ["", "Speed: native / fix = %.2fx (mean wall seconds per simulated second)."
+                  % (wall["native"] / wall["fibre"])]
     lines += ["%s clogged at seeds %s." % (m, " ".join(clogs[m])) for m in METHODS if clogs[m]]
     lines += ["", "Made with `compare.py %s`." % " ".join(
         "'%s'" % w if (" " in w or not w) else w for w in sys.argv[1:])]
@@ -801,6 +839,9 @@ def main():
                    help="also pair the fix with the fix's runs of this prefix")
     s.add_argument("--native-against-tag", default=None,
                    help="also pair native with native's runs of this prefix")
+    s.add_argument("--from-table", default=None,
+                   help="native's figures (and the former fix's) from this seeds table; "
+                        "runs the fix only")
     s.add_argument("--out", default=DEFAULT_OUT)
     i = sub.add_parser("picture", help="PNG snapshot of a run with dump image")
     i.add_argument("scene", choices=PILE_SCENES)

@@ -10,11 +10,15 @@ curves with known answers, no LAMMPS run:
 - the seeds' statistics (paired_stats): each twin's mean, range and spread over its own
   seeds, the difference paired by seed with its standard error, a clogged seed (NaN) and a
   seed one twin lacks left out of the pairs, and the difference of the twins' own means with
-  its standard error, against values worked out by hand.
+  its standard error, against values worked out by hand;
+- a former seeds table read back (read_seeds_table, for `seeds --from-table`): each twin's
+  figures per seed, clogged as NaN, the statistics rows left out.
 """
 
+import math
 import os
 import sys
+import tempfile
 
 import numpy as np
 
@@ -71,6 +75,29 @@ def main():
              and abs(st["means_rel"] - 5.0 / 24 / 4.825) < 1e-12
              and abs(st["means_rel_se"] - 13.0 / 120 / 4.825) < 1e-12,
              "the difference of the twins' own means and its error", "%s" % st)
+
+    silo = ("silo, N 1400, 3 seeds\n\n"
+            "| seed | native discharge rate (kg/s) | native wall s / simulated s "
+            "| fibre discharge rate (kg/s) | fibre wall s / simulated s |\n"
+            "|---|---|---|---|---|\n"
+            "| 4767 | 13.57 | 30.20 | 11.16 | 5.44 |\n"
+            "| 1031 | clogged | 46.98 | 12.67 | 5.37 |\n"
+            "| 3037 | 12.72 | 44.70 | clogged | 2.67 |\n\n"
+            "| figure | native: mean (range), sd | fix: mean (range), sd | fix - native | means |\n"
+            "|---|---|---|---|---|\n"
+            "| discharge rate (kg/s) | 13.1 (12.7..13.6), 0.6, 2 seeds | 11.9 | -9.3% | -9.3% |\n")
+    with tempfile.NamedTemporaryFile("w", suffix=".md", delete=False) as f:
+        f.write(silo)
+    try:
+        t = compare.read_seeds_table(f.name, "silo")
+    finally:
+        os.unlink(f.name)
+    ck.check(sorted(t["native"]["rate"]) == ["1031", "3037", "4767"]
+             and t["native"]["rate"]["4767"] == 13.57 and t["fibre"]["rate"]["1031"] == 12.67
+             and t["native"]["wall_per_s"]["1031"] == 46.98
+             and t["fibre"]["wall_per_s"]["3037"] == 2.67
+             and math.isnan(t["native"]["rate"]["1031"]) and math.isnan(t["fibre"]["rate"]["3037"]),
+             "a seeds table read back: each twin per seed, clogged as NaN", "%s" % t)
     ck.close()
 
 
