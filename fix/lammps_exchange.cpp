@@ -32,9 +32,18 @@ class PointHalo final : public fibre::Exchange::Halo {
       : comm_(comm), ghosts_(std::move(ghosts)), shared_(std::move(shared)),
         images_(std::move(images)), colours_(colours), colour_(colour)
   {
+    for (const std::vector<Link> *links : {&ghosts_, &shared_})
+      for (const Link &l : *links) bodies_.insert(bodies_.end(), l.bodies.begin(), l.bodies.end());
+    for (const auto &[image, body] : images_) {
+      bodies_.push_back(image);
+      bodies_.push_back(body);
+    }
+    std::sort(bodies_.begin(), bodies_.end());
+    bodies_.erase(std::unique(bodies_.begin(), bodies_.end()), bodies_.end());
   }
   int colours() const override { return colours_; }
   int colour() const override { return colour_; }
+  const std::vector<int> *bodies() const override { return &bodies_; }
 
   void sum_copies(fibre::Vector &v) const override
   {
@@ -93,6 +102,7 @@ class PointHalo final : public fibre::Exchange::Halo {
   std::vector<Link> ghosts_; // per owner process, ascending: the touched ghosts it owns
   std::vector<Link> shared_; // per process, ascending: the owned bodies it touches as ghosts
   std::vector<std::pair<int, int>> images_; // touched periodic images here, and their bodies
+  std::vector<int> bodies_;                 // every body above, once, ascending
   int colours_, colour_;
   mutable std::vector<double> in_, out_;
   mutable std::vector<MPI_Request> requests_;

@@ -418,7 +418,19 @@ PgsResult pgs(const ContactSystem &sys, const Exchange &ex, const Cones &cones, 
   if (control.fibre_blocks)
     for (int c = 0; c < nc; ++c) cones.project(lambda.data() + Eigen::Index(rows) * c, c);
   Vector dv = velocity_change(sys, ex, lambda);
-  Vector dv_start, moved; // reused by every sweep
+  // Each phase's changes go to the other processes as `moved`, from dv_start, its start: on the
+  // halo's bodies only where it names them (a few dozen, where a full vector has every ghost).
+  const std::vector<int> *halo_bodies = halo ? copies->bodies() : nullptr;
+  Vector dv_start = halo ? dv : Vector(), moved = halo ? Vector::Zero(dv.size()) : Vector();
+  const auto keep_start = [&] {
+    if (!halo_bodies) {
+      dv_start = dv;
+      return;
+    }
+    for (const int body : *halo_bodies)
+      dv_start.segment<kBodyDofs>(kBodyDofs * Eigen::Index(body)) =
+          dv.segment<kBodyDofs>(kBodyDofs * Eigen::Index(body));
+  };
   // Impulses to fall back on when a sweep turns non-finite: a copy every kCheckpointSweeps
   // sweeps, not every sweep (stiff steps take hundreds), and every sweep for nonlinear CG,
   // whose direction is the sweep's change.
@@ -459,7 +471,7 @@ PgsResult pgs(const ContactSystem &sys, const Exchange &ex, const Cones &cones, 
   std::vector<int> focus_contacts;
   for (int s = 0; s < control.max_sweeps; ++s) {
     // dv follows this process's updates; `moved` collects them for the other processes.
-    if (halo) dv_start = dv;
+    if (halo) keep_start();
     if (control.nonlinear_cg || s % kCheckpointSweeps == 0) lambda_start = lambda;
     if (blocks) blocks->correct(b, lambda, dv);
     double norms[2] = {0, 0}; // ||change||^2, ||lambda||^2
@@ -493,15 +505,31 @@ PgsResult pgs(const ContactSystem &sys, const Exchange &ex, const Cones &cones, 
         sweep<3>(sys, cones, b, inv_mass, inv_scale, ex.local_owners(), visit, n, lambda, dv, norms,
                  changes);
       if (halo) {
-        moved = dv - dv_start;
-        if (split.size()) moved.array() /= split.array();
+        if (!halo_bodies) {
+          moved = dv - dv_start;
+          if (split.size()) moved.array() /= split.array();
+          copies->sum_copies(moved);
+          dv = dv_start + moved;
+          return;
+        }
+        for (const int body : *halo_bodies) {
+          const Eigen::Index at = kBodyDofs * Eigen::Index(body);
+          moved.segment<kBodyDofs>(at) =
+              dv.segment<kBodyDofs>(at) - dv_start.segment<kBodyDofs>(at);
+          if (split.size())
+            moved.segment<kBodyDofs>(at).array() /= split.segment<kBodyDofs>(at).array();
+        }
         copies->sum_copies(moved);
-        dv = dv_start + moved;
+        for (const int body : *halo_bodies) {
+          const Eigen::Index at = kBodyDofs * Eigen::Index(body);
+          dv.segment<kBodyDofs>(at) =
+              dv_start.segment<kBodyDofs>(at) + moved.segment<kBodyDofs>(at);
+        }
       }
     };
     if (coloured) {
       for (std::size_t p = 0; p < phases.size(); ++p) {
-        if (p > 0) dv_start = dv; // the first phase starts where the sweep does
+        if (p > 0) keep_start(); // the first phase starts where the sweep does
         sweep_and_sum(phases[p].data(), static_cast<int>(phases[p].size()),
                       grouped.empty() ? nullptr : grouped[p].get());
       }

@@ -48,6 +48,9 @@ class Exchange {
     // reverse_sum, then forward, on those bodies only. Copies that no process touches, and
     // ghosts that this process does not touch, keep their values.
     virtual void sum_copies(Vector &body_vec) const = 0;
+    // The local bodies whose entries sum_copies reads or writes, ascending; null: every body.
+    // The sweeps then carry only these bodies' changes around the exchange.
+    virtual const std::vector<int> *bodies() const { return nullptr; }
     // Two colours for the processes, so that as few processes as may be that touch a common
     // body share a colour (alike on every process): the sweeps visit the contacts on shared
     // bodies one colour at a time, as one process would, and split the masses of the bodies
