@@ -16,10 +16,13 @@ in.janssen.native with seeds 4767, 1031 and 2203: 2,560 spheres filled in 4 batc
   round-off). One seed's p_sat scatters by about 9% (standard deviation; fibre 32.8 to 41.9
   over nine runs), so two seeds' mean moved from 1.075 to 1.118 of native's with round-off
   alone: three seeds, the target's own measurement, are compared.
-- on two processes (seed 4767, the fix only): the walls' loads, summed over the processes,
-  still balance the weight within 3%, the floor carries less than 80% of it, and p_sat is
-  within 30% of native's mean (over three standard deviations of one seed's scatter: a check
-  against gross errors, as the trajectories part at round-off).
+- on two processes (seed 4767, the fix only), against the serial run of the same seed: the
+  walls' loads, summed over the processes, still balance the weight within 3%, the floor
+  carries less than 80% of it, the deep pressure is within 10% and p_sat within 30% (the
+  trajectories part at round-off, and the fitted p_sat scatters by about 9% a run: a check
+  against gross errors). Seed 4767's p_sat sits high (46.0 serial, 1.28 of native's mean), so
+  the serial run of the same seed is the reference, not native's mean. Measured (session 40):
+  np 2 against serial, deep 32.00 against 31.96, p_sat 47.9 against 46.0.
 """
 
 import argparse
@@ -39,6 +42,7 @@ def main():
     import janssen  # examples/janssen/janssen.py, copied with the scene
 
     results = {}
+    serial = None  # the fix's run of SEEDS[0], the parallel run's reference
     for seed in SEEDS:
         run_args = argparse.Namespace(**vars(args))
         run_args.workdir = os.path.join(args.workdir, "seed%d" % seed)
@@ -48,6 +52,8 @@ def main():
             measured = run_twin(run_args, ck, janssen, seed, method, name)
             if measured:
                 results.setdefault(method, []).append(measured)
+                if method == "fibre" and seed == SEEDS[0]:
+                    serial = measured
     parallel = None
     if args.mpirun:
         run_args = argparse.Namespace(**vars(args))
@@ -65,11 +71,13 @@ def main():
             ck.check(abs(ratio - 1.0) < 0.10, "%s within 10%% of native (mean of seeds %s)"
                      % (what, ", ".join(str(s) for s in SEEDS)),
                      "fibre %.3f, native %.3f (ratio %.3f)" % (f[key], n[key], ratio))
-        if parallel:
-            ratio = parallel["p_sat"] / n["p_sat"]
-            ck.check(abs(ratio - 1.0) < 0.30, "np 2: Janssen's saturation pressure within 30% of "
-                     "native's mean", "fibre np 2 %.3f, native %.3f (ratio %.3f)"
-                     % (parallel["p_sat"], n["p_sat"], ratio))
+    if parallel and serial:
+        for key, what, bound in (("deep", "deep side-wall pressure", 0.10),
+                                 ("p_sat", "Janssen's saturation pressure", 0.30)):
+            ratio = parallel[key] / serial[key]
+            ck.check(abs(ratio - 1.0) < bound, "np 2: %s within %d%% of the serial run of seed %d"
+                     % (what, round(100 * bound), SEEDS[0]), "np 2 %.3f, serial %.3f (ratio %.3f)"
+                     % (parallel[key], serial[key], ratio))
     ck.close()
 
 
