@@ -721,11 +721,11 @@ def cmd_seeds(a):
             lines.append("| %s | %s over %d seeds | %s |" % (
                 label, difference(st, fmt, relative), st["paired"],
                 difference(st, fmt, relative, True)))
-    wall = {m: np.mean(list(values[m]["wall_per_s"].values())) for m in METHODS}
     if former:
         lines += ["", "Native's figures and wall seconds are those of `%s`, so no speed ratio."
                   % os.path.basename(a.from_table)]
     else:
+        wall = {m: np.mean(list(values[m]["wall_per_s"].values())) for m in METHODS}
         lines += ["", "Speed: native / fix = %.2fx (mean wall seconds per simulated second)."
                   % (wall["native"] / wall["fibre"])]
     lines += ["%s clogged at seeds %s." % (m, " ".join(clogs[m])) for m in METHODS if clogs[m]]
