@@ -101,6 +101,12 @@ void sweep(const ContactSystem &sys, const Cones &cones, const Vector &b, const 
   }
 }
 
+// A body's kBodyDofs entries of a per-body vector.
+template <class V> auto body_entries(V &v, int body)
+{
+  return v.template segment<kBodyDofs>(kBodyDofs * Eigen::Index(body));
+}
+
 // The body that holds a local body's velocity: itself, or an image's body (Exchange::local_owners).
 int owner_of(const std::vector<int> &owners, int body)
 {
@@ -427,9 +433,7 @@ PgsResult pgs(const ContactSystem &sys, const Exchange &ex, const Cones &cones, 
       dv_start = dv;
       return;
     }
-    for (const int body : *halo_bodies)
-      dv_start.segment<kBodyDofs>(kBodyDofs * Eigen::Index(body)) =
-          dv.segment<kBodyDofs>(kBodyDofs * Eigen::Index(body));
+    for (const int body : *halo_bodies) body_entries(dv_start, body) = body_entries(dv, body);
   };
   // Impulses to fall back on when a sweep turns non-finite: a copy every kCheckpointSweeps
   // sweeps, not every sweep (stiff steps take hundreds), and every sweep for nonlinear CG,
@@ -513,18 +517,12 @@ PgsResult pgs(const ContactSystem &sys, const Exchange &ex, const Cones &cones, 
           return;
         }
         for (const int body : *halo_bodies) {
-          const Eigen::Index at = kBodyDofs * Eigen::Index(body);
-          moved.segment<kBodyDofs>(at) =
-              dv.segment<kBodyDofs>(at) - dv_start.segment<kBodyDofs>(at);
-          if (split.size())
-            moved.segment<kBodyDofs>(at).array() /= split.segment<kBodyDofs>(at).array();
+          body_entries(moved, body) = body_entries(dv, body) - body_entries(dv_start, body);
+          if (split.size()) body_entries(moved, body).array() /= body_entries(split, body).array();
         }
         copies->sum_copies(moved);
-        for (const int body : *halo_bodies) {
-          const Eigen::Index at = kBodyDofs * Eigen::Index(body);
-          dv.segment<kBodyDofs>(at) =
-              dv_start.segment<kBodyDofs>(at) + moved.segment<kBodyDofs>(at);
-        }
+        for (const int body : *halo_bodies)
+          body_entries(dv, body) = body_entries(dv_start, body) + body_entries(moved, body);
       }
     };
     if (coloured) {

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstdio>
 #include <limits>
+#include <memory>
 #include <numeric>
 #include <utility>
 
@@ -283,6 +284,100 @@ TEST(Pgs, MassSplittingStopsSharedBodiesFromOvershooting)
   // (two contacts in parallel are twice as stiff: Sigma / (1 / m) = 9e-7 apart)
   EXPECT_NEAR(lambda[0], 0.5 * whole[0], 1e-5 * whole[0]);
   EXPECT_NEAR(lambda[3], 0.5 * whole[0], 1e-5 * whole[0]);
+}
+
+namespace {
+
+// One process whose body `body` has a ghost copy `ghost` (as another process's copy of it
+// would be) holding some of its contacts. With `named`, its halo names the two bodies
+// (Halo::bodies, as LAMMPS's does), and the sweeps carry only their changes around each
+// exchange; without, every body's (the default halo's full vectors).
+class GhostOfBody final : public Exchange {
+ public:
+  GhostOfBody(int body, int ghost, bool named) : body_(body), ghost_(ghost), named_(named) {}
+  void forward(Vector &v) const override { v.segment<6>(6 * ghost_) = v.segment<6>(6 * body_); }
+  void reverse_sum(Vector &v) const override
+  {
+    v.segment<6>(6 * body_) += v.segment<6>(6 * ghost_);
+    v.segment<6>(6 * ghost_).setZero();
+  }
+  void sum(double *, int) const override {}
+  void max(double *, int) const override {}
+  long exclusive_prefix_sum(long) const override { return 0; }
+  std::unique_ptr<Halo> halo(const std::vector<char> &, bool) const override
+  {
+    return std::make_unique<Copies>(*this, named_);
+  }
+
+ private:
+  class Copies final : public Halo {
+   public:
+    Copies(const GhostOfBody &ex, bool named)
+        : ex_(ex), bodies_{std::min(ex.body_, ex.ghost_), std::max(ex.body_, ex.ghost_)},
+          named_(named)
+    {
+    }
+    void sum_copies(Vector &v) const override
+    {
+      ex_.reverse_sum(v);
+      ex_.forward(v);
+    }
+    const std::vector<int> *bodies() const override { return named_ ? &bodies_ : nullptr; }
+
+   private:
+    const GhostOfBody &ex_;
+    std::vector<int> bodies_;
+    bool named_;
+  };
+  int body_, ghost_;
+  bool named_;
+};
+
+} // namespace
+
+// A frictional pile whose busiest sphere is split between two copies, every other one of its
+// contacts on the ghost: the sweeps over the halo's two bodies only take the full vectors'
+// sweeps and impulses (to round-off), and both converge to the whole sphere's impulses on
+// one process (the mass-split copies' fixed point is the serial one).
+TEST(Pgs, HaloOfNamedBodiesCarriesTheSameChanges)
+{
+  const Problem pr = pile(60, 0.4);
+  const int n = pr.sys.num_bodies();
+  std::vector<int> degree(n, 0);
+  for (const Contact &c : pr.sys.contacts()) {
+    ++degree[c.a];
+    if (c.b >= 0) ++degree[c.b];
+  }
+  const int body = int(std::max_element(degree.begin(), degree.end()) - degree.begin());
+  ASSERT_GE(degree[body], 4);
+  std::vector<Body> bodies = pr.sys.bodies();
+  bodies.push_back(bodies[body]);
+  std::vector<Contact> contacts = pr.sys.contacts();
+  int moved = 0;
+  for (Contact &c : contacts)
+    if (c.a == body || c.b == body) {
+      if (moved++ % 2 == 0) continue;
+      (c.a == body ? c.a : c.b) = n;
+    }
+  const ContactSystem split(bodies, contacts, pr.sys.rows(), pr.sys.params(), n);
+  const Vector b = spook_rhs(split);
+  const Cones cones(split);
+  const std::vector<Vec6> scale = row_scales(split);
+  PgsControl control{20000, 0.0, 20000};
+  control.accuracy = 1e-11;
+  Vector named = Vector::Zero(split.contact_dofs()), full = named;
+  const PgsResult a = pgs(split, GhostOfBody(body, n, true), cones, b, scale, named, control);
+  const PgsResult f = pgs(split, GhostOfBody(body, n, false), cones, b, scale, full, control);
+  EXPECT_EQ(a.reason, StopReason::converged);
+  EXPECT_EQ(a.sweeps, f.sweeps);
+  EXPECT_GT(a.sweeps, 20);
+  EXPECT_LT(rel_diff(named, full), 1e-12);
+
+  Vector whole = Vector::Zero(pr.sys.contact_dofs());
+  const PgsResult w =
+      pgs(pr.sys, serial_exchange(), Cones(pr.sys), pr.b, row_scales(pr.sys), whole, control);
+  EXPECT_EQ(w.reason, StopReason::converged);
+  EXPECT_LT(rel_diff(named, whole), 1e-6) << rel_diff(named, whole);
 }
 
 namespace {
