@@ -29,6 +29,7 @@
 #include "fibre_detect.h"
 #include "fibre/spook.hpp"
 #include "fibre/stress.hpp"
+#include "fibre/substeps.hpp"
 #include "fibre/text.hpp"
 #include "fibre_output.h"
 #include "pair_coefficients.h"
@@ -449,39 +450,66 @@ void FixFibreContact::smallest_body(const std::vector<fibre::Body> &bodies)
   if (std::isfinite(m[1])) r_min_ = m[1];
 }
 
-// Once per step size, where the pair style is a material and the group has atoms: the step
-// against the law's shortest collision time, the number that says whether the step resolves
-// the collisions of a flow (doc page, "Time step and stiff materials").
-void FixFibreContact::log_step_against_collision()
+// The contact solve's substeps this step (fibre::substeps_for: automatic from the law's
+// shortest collision time for two spheres of the group's smallest radius and mass at 1 velocity
+// unit), alike on every process. Logged once per step size and count, with the step against
+// that collision time, the number that says whether the step resolves the collisions of a flow
+// (doc page, "Time step and stiff materials").
+int FixFibreContact::step_substeps()
 {
   const fibre::ContactModel &model = settings_.model;
-  if (dtv_ == step_logged_ || !(m_min_ > 0) || !(r_min_ > 0) || !model.compliance.material) return;
+  fibre::PairCollisionTime shortest{};
+  if (model.compliance.material && m_min_ > 0 && r_min_ > 0)
+    shortest = fibre::shortest_collision_time(model.materials, r_min_, m_min_, 1.0);
+  const int n = fibre::substeps_for(model, dtv_, shortest.t_c);
+  if ((dtv_ == step_logged_ && n == substeps_logged_) || !(shortest.t_c > 0)) return n;
   step_logged_ = dtv_;
-  const fibre::PairCollisionTime shortest =
-      fibre::shortest_collision_time(model.materials, r_min_, m_min_, 1.0);
-  if (!(shortest.t_c > 0) || comm->me != 0) return;
+  substeps_logged_ = n;
+  if (comm->me != 0) return n;
   const auto g = [](double x) { return fibre::format_g(x); };
-  logmesg(lmp, "fix fibre_contact: the step " + g(dtv_) + " is " + g(dtv_ / shortest.t_c) +
-                   " collision times of the pair style's law (t_c " + g(shortest.t_c) +
-                   ": two spheres of the smallest radius " + g(r_min_) + " and mass " + g(m_min_) +
-                   " meeting at 1 velocity unit, type pair " + std::to_string(shortest.i) + " " +
-                   std::to_string(shortest.j) +
-                   "). Above about 0.3 t_c a collisional flow's contacts act as enduring ones, "
-                   "and its heaps and flows come out steeper and less mobile than the law's "
-                   "(doc page, \"Time step and stiff materials\")\n");
+  const double per = dtv_ / n / shortest.t_c;
+  std::string text =
+      "fix fibre_contact: the step " + g(dtv_) + " is " + g(dtv_ / shortest.t_c) +
+      " collision times of the pair style's law (t_c " + g(shortest.t_c) +
+      ": two spheres of the smallest radius " + g(r_min_) + " and mass " + g(m_min_) +
+      " meeting at 1 velocity unit, type pair " + std::to_string(shortest.i) + " " +
+      std::to_string(shortest.j) + "); the contact solve takes " + std::to_string(n) +
+      (n == 1 ? " substep" : " substeps") + " of " + g(per) + " t_c (substeps " +
+      (model.substeps > 0 ? std::to_string(model.substeps)
+                          : "auto, at most " + g(model.substep_collisions) + " t_c each") +
+      ")";
+  if (per > 0.5)
+    text += ". Above about 0.5 t_c a substep lets a collisional flow's contacts act as enduring "
+            "ones, and its heaps and flows come out steeper and less mobile than the law's";
+  logmesg(lmp, text + " (doc page, \"Time step and stiff materials\")\n");
+  return n;
 }
 
 // Approach speeds at or below this are plastic (ContactModel::bounce_speed); the automatic rule
 // reads the external forces of every process.
-double FixFibreContact::bounce_speed(const std::vector<fibre::Body> &bodies) const
+double FixFibreContact::bounce_speed(const std::vector<fibre::Body> &bodies, double h) const
 {
   const fibre::ContactModel &model = settings_.model;
   if (!model.may_bounce() || model.bounce_speed >= 0) return std::max(model.bounce_speed, 0.0);
-  double v = fibre::external_speed_per_step(bodies, exchange_->num_owned(), dtv_);
+  double v = fibre::external_speed_per_step(bodies, exchange_->num_owned(), h);
   MPI_Allreduce(MPI_IN_PLACE, &v, 1, MPI_DOUBLE, MPI_MAX, world);
   // Without external forces every approach would bounce, the new contacts of a sheared pack
   // too (it threw grains out of the shear cell): then the automatic overlap recovery speed.
-  return v > 0 ? model.bounce_steps * v : model.recovery_radii * r_min_ / dtv_;
+  return v > 0 ? model.bounce_steps * v : model.recovery_radii * r_min_ / h;
+}
+
+// With substeps the positions follow the substeps' velocities, x_{n+1} = x_n + hs sum_k v_k,
+// so that the gaps the substeps moved are the gaps the next step detects. initial_integrate
+// adds dtv v_final; the rest goes in now (path: the sum of the n substeps' velocities, the
+// final one's last). A body at rest or in free flight of one velocity moves as without.
+void FixFibreContact::follow_substeps(const fibre::Vector &path, int n, double hs)
+{
+  double **x = atom->x, **v = atom->v;
+  const std::vector<int> &body_atom = exchange_->body_atom();
+  for (int k = 0; k < exchange_->num_owned(); ++k) {
+    const int i = body_atom[k];
+    for (int d = 0; d < 3; ++d) x[i][d] += hs * path[6 * k + d] - n * hs * v[i][d];
+  }
 }
 
 // At the first step of a run: overlaps deeper than kDeepOverlap of the smaller diameter are
@@ -583,9 +611,11 @@ void FixFibreContact::final_integrate()
   std::vector<fibre::DetectedContact> found =
       detection_->contacts(bodies, dtv_, model.damping, model.may_bounce());
   smallest_body(bodies);
-  log_step_against_collision();
-  fibre::SpookParams params{dtv_, model.damping, model.max_recovery(dtv_, r_min_)};
-  params.bounce_speed = bounce_speed(bodies);
+  // the contact solve runs in substeps of hs (fibre/substeps.hpp); detection keeps the step
+  const int substeps = step_substeps();
+  const double hs = dtv_ / substeps;
+  fibre::SpookParams params{hs, model.damping, model.max_recovery(hs, r_min_)};
+  params.bounce_speed = bounce_speed(bodies, hs);
   if (first_step_) warn_deep_overlaps(bodies, found, params.max_recovery);
   first_step_ = false;
   const bool any = output_->count_contacts(found) > 0;
@@ -596,36 +626,71 @@ void FixFibreContact::final_integrate()
   std::vector<fibre::Contact> contacts;
   contacts.reserve(found.size());
   for (const fibre::DetectedContact &fc : found) contacts.push_back(fc.contact);
-  const fibre::Vector warm = history_.warm_start(found, model.rows, dtv_);
+  fibre::Vector warm = history_.warm_start(found, model.rows, hs);
   history_.load_springs(found, contacts);
-  if (any) fibre::apply_contact_model(model, params, m_min_, bodies, contacts, &warm);
+  // substeps 1 .. n - 1; the last one is the step's system below, as without substeps
+  fibre::Substeps earlier;
+  if (any && substeps > 1)
+    earlier = fibre::run_substeps(
+        substeps, model, params, m_min_, *exchange_, exchange_->num_owned(), bodies, contacts, warm,
+        [this](fibre::ContactSystem &s, const fibre::Vector &w) { return solve(s, w); });
+  const fibre::Vector warm_last = warm;
+  if (any) fibre::apply_contact_model(model, params, m_min_, bodies, contacts, &warm_last);
   fibre::ContactSystem sys(std::move(bodies), std::move(contacts), model.rows, params,
                            exchange_->num_owned());
 
   // solve and apply
   fibre::StepResult res;
-  if (any) res = solve(sys, warm);
-  update_velocities(res.dv.size() > 0 ? &res.dv : nullptr);
-  tally_wall_loads(sys, found, res.lambda);
+  if (any) res = solve(sys, warm_last);
+  const bool substepped = earlier.done > 0 && res.dv.size() == earlier.dv.size();
+  // the step's impulses (the substeps' sum) and velocity change
+  const fibre::Vector lambda_step =
+      substepped ? fibre::Vector(earlier.lambda + res.lambda) : res.lambda;
+  if (substepped) {
+    const fibre::Vector dv_step = earlier.dv + res.dv;
+    update_velocities(&dv_step);
+  } else {
+    update_velocities(res.dv.size() > 0 ? &res.dv : nullptr);
+  }
+  // the loads and the virial of the step's mean force (sys's step is a substep's)
+  const fibre::Vector lambda_mean =
+      substepped ? fibre::Vector(lambda_step / double(earlier.done + 1)) : res.lambda;
+  tally_wall_loads(sys, found, lambda_mean);
   if (evflag) // this step's virial is wanted (post_force)
-    tally_virial(sys, res.lambda.size() ? res.lambda : fibre::Vector::Zero(sys.contact_dofs()));
+    tally_virial(sys, lambda_mean.size() ? lambda_mean : fibre::Vector::Zero(sys.contact_dofs()));
   // the elastic rows' springs (compliance material) and the energy the moving walls put in and
   // the contacts take out, both from the velocities after the step (collective: every process)
   std::vector<std::array<double, fibre::kMaxRows>> springs;
   if (any) {
     const fibre::Vector v_plus = fibre::velocities_after_change(sys, *exchange_, res.dv);
     if (model.compliance.material) springs = fibre::advance_springs(sys, v_plus, res.lambda);
-    output_->add_work(fibre::contact_work(sys, v_plus, res.lambda));
+    fibre::ContactWork work = fibre::contact_work(sys, v_plus, res.lambda);
+    if (substepped) {
+      work.wall_work += earlier.work.wall_work;
+      work.dissipation += earlier.work.dissipation;
+      follow_substeps(earlier.path + v_plus, earlier.done + 1, hs);
+    }
+    output_->add_work(work);
   }
-  overflow_count_ += history_.store(found, res.lambda, model.rows, dtv_, atom->nlocal,
+  overflow_count_ += history_.store(found, res.lambda, model.rows, hs, atom->nlocal,
                                     springs.empty() ? nullptr : &springs);
 
   // report
-  output_->fill_local(found, any ? &res.lambda : nullptr, model.rows, array_local, size_local_rows);
-  output_->report_solve(res);
-  if (do_export)
-    output_->export_step(settings_.export_prefix, sys, found, any ? &res.lambda : nullptr, warm,
-                         exchange_->local_owners());
+  output_->fill_local(found, any ? &lambda_step : nullptr, model.rows, array_local,
+                      size_local_rows);
+  if (substepped) {
+    fibre::StepResult all = earlier.totals;
+    fibre::add_solve(all, res);
+    all.iterations = res.iterations;
+    all.rel_residual = res.rel_residual;
+    all.fibres = res.fibres;
+    output_->report_solve(all);
+  } else {
+    output_->report_solve(res);
+  }
+  if (do_export) // with substeps, the last one's system and warm start
+    output_->export_step(settings_.export_prefix, sys, found, any ? &res.lambda : nullptr,
+                         warm_last, exchange_->local_owners());
   if (overflow_count_ > 0 && !overflow_warned_ && comm->me == 0) {
     warn(error, FLERR,
          "Fix fibre_contact: more than " + std::to_string(fibre::ContactHistory::kMaxSlots) +

@@ -69,8 +69,9 @@ class FixFibreContact : public Fix {
   void read_coefficients();
   void check_finite(const char *what, double **array, int nvalues) const;
   void smallest_body(const std::vector<fibre::Body> &bodies);
-  double bounce_speed(const std::vector<fibre::Body> &bodies) const;
-  void log_step_against_collision();
+  double bounce_speed(const std::vector<fibre::Body> &bodies, double h) const;
+  void follow_substeps(const fibre::Vector &path, int n, double hs);
+  int step_substeps();
   double simulated_time() const;
   void tally_wall_loads(const fibre::ContactSystem &sys,
                         const std::vector<fibre::DetectedContact> &found,
@@ -88,6 +89,7 @@ class FixFibreContact : public Fix {
   double m_min_ = 0.0, r_min_ = 0.0;
   bool first_step_ = true;
   double step_logged_ = 0.0;   // the step whose ratio to the collision time the log states
+  int substeps_logged_ = 0;    // and its substeps
   class Pair *pair_ = nullptr; // pair style whose force computation this fix switched off
   std::unique_ptr<fibre_lmp::LammpsExchange> exchange_;
   std::unique_ptr<fibre_lmp::LammpsDetection> detection_;

@@ -21,7 +21,7 @@ LAYERS = {
     3: ["solver_control", "preconditioner", "preconditioner_family", "krylov", "direct", "pgs", "sweep_groups",
         "fibre_blocks", "apgd", "spectra", "analysis", "combined_preconditioner",
         "nonsmooth_reference"],
-    4: ["step_solver", "accuracy_study"],
+    4: ["step_solver", "accuracy_study", "substeps"],
     5: ["settings"],
 }
 FRONT_END = 6

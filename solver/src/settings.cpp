@@ -1,5 +1,7 @@
 #include "fibre/settings.hpp"
 
+#include "fibre/substeps.hpp"
+
 #include "fibre/text.hpp"
 
 namespace fibre {
@@ -257,6 +259,18 @@ std::size_t read_model_keyword(const Reader &in, std::size_t i, Settings &s)
     s.model.bounce_speed = v;
     return 2;
   }
+  if (key == "substeps") {
+    const std::string e = "'substeps auto|<integer 1 to " + std::to_string(kMaxSubsteps) + ">'";
+    if (!in.has(i + 1)) Reader::illegal(e);
+    s.model.substeps =
+        in.at(i + 1) == "auto" ? 0 : static_cast<int>(in.integer(i + 1, e, 1, kMaxSubsteps));
+    return 2;
+  }
+  if (key == "substep_collisions") {
+    s.model.substep_collisions =
+        in.positive(i + 1, "'substep_collisions <positive number of collision times>'");
+    return 2;
+  }
   if (key == "rows") {
     const std::string e = "'rows 3|6'";
     long v = 0;
@@ -298,7 +312,7 @@ Settings parse_settings(const std::vector<std::string> &args)
           "compliance, damping, mu, mu_roll, mu_twist, rows, active_set, sweeps, "
           "sweep_tol, rescue_sweeps, min_sweeps, focus_sweeps, anderson, anderson_period, "
           "sweep_cg, sweep_blocks, sweep_groups, recovery_speed, restitution, bounce_speed, "
-          "coefficients, normal_relaxation, wall, export)",
+          "coefficients, normal_relaxation, substeps, substep_collisions, wall, export)",
           &key);
     i += used;
   }
@@ -341,6 +355,10 @@ std::string describe(const Settings &s)
                  : format_g(vb));
   out += std::string(", coefficients ") + to_string(s.model.coefficients);
   out += std::string(", normal_relaxation ") + to_string(s.model.normal_relaxation);
+  out += ", substeps " +
+         (s.model.substeps > 0
+              ? std::to_string(s.model.substeps)
+              : "auto (at most " + format_g(s.model.substep_collisions) + " collision times each)");
   const FrictionParams &f = s.model.friction;
   return out + ", mu " + format_g(f.mu) + ", mu_roll " + format_g(f.mu_roll) + ", mu_twist " +
          format_g(f.mu_twist);

@@ -65,8 +65,8 @@ TEST(Settings, NoKeywordsKeepTheDefaults)
       "compliance auto "
       "(0.01 dt^2 / m_min), recovery_speed auto (0.01 r_min / dt), restitution 0, "
       "bounce_speed auto (2 dt |f| / m max, or 0.01 r_min / dt without forces), coefficients "
-      "pair, normal_relaxation spook, mu 0.5, mu_roll 0, "
-      "mu_twist 0");
+      "pair, normal_relaxation spook, substeps auto (at most 0.5 collision times each), mu 0.5, "
+      "mu_roll 0, mu_twist 0");
 }
 
 TEST(Settings, EveryKeywordSetsWhatItNames)
@@ -225,6 +225,14 @@ TEST(Settings, BadInputNamesTheKeywordAndItsForm)
             "sweep_blocks yes, or focus_sweeps");
   EXPECT_EQ(error_of("rows 3 mu_roll 0.1"),
             "mu_roll and mu_twist need 'rows 6' (rows 3 has no rotational rows)");
+  EXPECT_EQ(error_of("substeps 0"), "expected 'substeps auto|<integer 1 to 1000>', got '0'");
+  EXPECT_EQ(error_of("substeps two"), "expected 'substeps auto|<integer 1 to 1000>', got 'two'");
+  EXPECT_EQ(error_of("substeps"), "expected 'substeps auto|<integer 1 to 1000>'");
+  EXPECT_EQ(error_of("substep_collisions 0"),
+            "expected 'substep_collisions <positive number of collision times>', got '0'");
+  EXPECT_EQ(parse_settings(words("substeps 7")).model.substeps, 7);
+  EXPECT_EQ(parse_settings(words("substeps 7 substeps auto")).model.substeps, 0);
+  EXPECT_DOUBLE_EQ(parse_settings(words("substep_collisions 0.3")).model.substep_collisions, 0.3);
   EXPECT_NE(error_of("speed 3").find("expected a keyword (form, solver"), std::string::npos);
   EXPECT_NE(error_of("speed 3").find("got 'speed'"), std::string::npos);
 }

@@ -67,6 +67,11 @@ struct ContactModel {
   double restitution = 0.0;
   double bounce_speed = -1.0;
   double bounce_steps = 2.0;
+  // The contact solve's substeps per step (substeps.hpp): > 0 that many, 0 (the default)
+  // automatic, the fewest of at most substep_collisions shortest collision times of the
+  // material's law (one where the step is that short already, or there is no law).
+  int substeps = 0;
+  double substep_collisions = 0.5;
   CoefficientSource coefficients = CoefficientSource::pair;
   NormalRelaxation normal_relaxation = NormalRelaxation::spook;
   TypedCoefficients typed{};

@@ -1,0 +1,155 @@
+// The contact solve in substeps (substeps.hpp): how many, and that n substeps of h / n are n
+// steps of h / n where the step's geometry holds (a head-on collision on a line), and that a
+// resting sphere's substeps carry its weight over the whole step.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <vector>
+
+#include "fibre/contact_model.hpp"
+#include "fibre/spook.hpp"
+#include "fibre/step_solver.hpp"
+#include "fibre/substeps.hpp"
+
+using namespace fibre;
+
+TEST(Substeps, AsManyAsTheCollisionTimeAsks)
+{
+  ContactModel model;
+  // automatic: the fewest of at most half the collision time (the material deck at E = 1e8:
+  // its step is 4.95 t_c)
+  EXPECT_EQ(substeps_for(model, 4.4343e-3, 8.96051e-4), 10);
+  EXPECT_EQ(substeps_for(model, 1.0, 1.0), 2); // exactly 0.5 t_c each
+  EXPECT_EQ(substeps_for(model, 0.3, 1.0), 1); // the step resolves the collisions already
+  EXPECT_EQ(substeps_for(model, 1.0, 0.0), 1); // no elastic law
+  EXPECT_EQ(substeps_for(model, 1.0, 1e-9), kMaxSubsteps);
+  model.substep_collisions = 0.25;
+  EXPECT_EQ(substeps_for(model, 1.0, 1.0), 4);
+  model.substeps = 3; // typed: that many, whatever the law
+  EXPECT_EQ(substeps_for(model, 1.0, 1e-9), 3);
+  EXPECT_EQ(substeps_for(model, 1.0, 0.0), 3);
+}
+
+namespace {
+
+// Frictionless compliant contacts of a fixed compliance, 3 rows, SPOOK d = 2.
+ContactModel compliant_model(double eps)
+{
+  ContactModel model;
+  model.rows = 3;
+  model.compliance.automatic = false;
+  model.compliance.eps_n = model.compliance.eps_t = eps;
+  model.friction = FrictionParams{0.0, 0.0, 0.0};
+  return model;
+}
+
+StepResult solve(ContactSystem &sys, const Vector &warm)
+{
+  StepOptions opt; // the fix's defaults, solved tighter than they stop
+  opt.stop.tol = 1e-12;
+  opt.accuracy = 1e-12;
+  return solve_step(sys, serial_exchange(), opt, &warm, MPI_COMM_SELF);
+}
+
+// The last substep as the fix does it: the model, the system, the solve; returns v+.
+Vector last_substep(const ContactModel &model, const SpookParams &params, std::vector<Body> bodies,
+                    std::vector<Contact> contacts, const Vector &warm, Vector &lambda)
+{
+  apply_contact_model(model, params, 1.0, bodies, contacts, &warm);
+  ContactSystem sys(std::move(bodies), std::move(contacts), model.rows, params);
+  const StepResult res = solve(sys, warm);
+  lambda = res.lambda;
+  return velocities_after_change(sys, serial_exchange(), res.dv);
+}
+
+} // namespace
+
+// Two spheres (radius 0.5, masses 1 and 2) meet head-on at 1 m/s each, 1 cm apart, at a step
+// of 10 ms, about five of their contact's collision times (k = 1e6). Ten substeps of 1 ms
+// (the gap moved by h G v+) give what ten steps of 1 ms give with the contact built anew from
+// the positions each step (x += h v+, as the fix's positions follow the substeps): the same
+// velocities, the same impulse over the step and the same path, to round-off; momentum is
+// conserved.
+TEST(Substeps, AreStepsOfTheirLengthWhereTheGeometryHolds)
+{
+  const int n = 10;
+  const double h = 0.01, hs = h / n;
+  const ContactModel model = compliant_model(1e-6);
+  SpookParams params;
+  params.h = hs;
+  std::vector<Body> start(2);
+  start[0].radius = start[1].radius = 0.5;
+  start[0].mass = 1.0;
+  start[1].mass = 2.0;
+  start[0].x = Vec3(0, 0, 0);
+  start[1].x = Vec3(1.01, 0, 0);
+  start[0].v = Vec3(1, 0, 0);
+  start[1].v = Vec3(-1, 0, 0);
+
+  // the substeps, with the contact detected once
+  std::vector<Body> bodies = start;
+  std::vector<Contact> contacts{sphere_sphere_contact(bodies, 1, 0)};
+  Vector warm = Vector::Zero(3);
+  const Substeps earlier =
+      run_substeps(n, model, params, 1.0, serial_exchange(), 2, bodies, contacts, warm, solve);
+  ASSERT_EQ(earlier.done, n - 1);
+  Vector lambda_last;
+  const Vector v_final = last_substep(model, params, bodies, contacts, warm, lambda_last);
+  const Vector impulse = earlier.lambda + lambda_last;
+  const Vector path = earlier.path + v_final;
+
+  // the reference: n steps of hs, positions moved and the contact rebuilt each step
+  std::vector<Body> ref = start;
+  Vector ref_warm = Vector::Zero(3), ref_impulse = Vector::Zero(3), ref_v;
+  for (int k = 0; k < n; ++k) {
+    Vector lambda;
+    ref_v = last_substep(model, params, ref, {sphere_sphere_contact(ref, 1, 0)}, ref_warm, lambda);
+    ref_impulse += lambda;
+    ref_warm = lambda;
+    for (int b = 0; b < 2; ++b) {
+      ref[b].v = ref_v.segment<3>(6 * b);
+      ref[b].x += hs * ref[b].v;
+    }
+  }
+  ASSERT_GT(ref_impulse[0], 1.0); // they collided within the step
+  EXPECT_NEAR(impulse[0], ref_impulse[0], 1e-9 * ref_impulse[0]);
+  for (int b = 0; b < 2; ++b) {
+    EXPECT_LT((v_final.segment<3>(6 * b) - ref_v.segment<3>(6 * b)).norm(), 1e-9);
+    EXPECT_LT((start[b].x + hs * path.segment<3>(6 * b) - ref[b].x).norm(), 1e-11);
+  }
+  const Vec3 p =
+      start[0].mass * Vec3(v_final.segment<3>(0)) + start[1].mass * Vec3(v_final.segment<3>(6));
+  EXPECT_LT((p - Vec3(-1, 0, 0)).norm(), 1e-10); // 1 * 1 + 2 * (-1)
+}
+
+// A sphere resting on a floor under gravity: over four substeps the floor's impulses add up to
+// the weight times the step, and the sphere stays at rest.
+TEST(Substeps, CarryARestingSpheresWeightOverTheStep)
+{
+  const int n = 4;
+  const double h = 0.01, g = 9.81;
+  const double eps = 1e-9;
+  const ContactModel model = compliant_model(eps);
+  SpookParams params;
+  params.h = h / n;
+  std::vector<Body> bodies(1);
+  bodies[0].radius = 0.5;
+  bodies[0].mass = 2.0;
+  bodies[0].x = Vec3(0, 0, 0.5);
+  bodies[0].force = Vec3(0, 0, -g * bodies[0].mass);
+  // at the overlap its weight holds on the compliant floor (SPOOK's static state: eps F)
+  std::vector<Contact> contacts{
+      sphere_wall_contact(bodies, 0, Vec3::UnitZ(), 0.5 - eps * g * bodies[0].mass)};
+  // the warm start of a sphere that has rested there: its weight over a substep
+  Vector warm = Vector::Zero(3);
+  warm[0] = g * bodies[0].mass * params.h;
+  const Substeps earlier =
+      run_substeps(n, model, params, 1.0, serial_exchange(), 1, bodies, contacts, warm, solve);
+  ASSERT_EQ(earlier.done, n - 1);
+  Vector lambda_last;
+  const Vector v_final = last_substep(model, params, bodies, contacts, warm, lambda_last);
+  const double weight_impulse = g * 2.0 * h;
+  EXPECT_NEAR(earlier.lambda[0] + lambda_last[0], weight_impulse, 1e-8 * weight_impulse);
+  EXPECT_LT(v_final.norm(), 1e-8 * g * h);
+  EXPECT_LT(std::abs(earlier.path[2]), 1e-8 * g * h);
+}
