@@ -478,9 +478,10 @@ int FixFibreContact::step_substeps()
       (model.substeps > 0 ? std::to_string(model.substeps)
                           : "auto, at most " + g(model.substep_collisions) + " t_c each") +
       ")";
-  if (per > 0.5)
-    text += ". Above about 0.5 t_c a substep lets a collisional flow's contacts act as enduring "
-            "ones, and its heaps and flows come out steeper and less mobile than the law's";
+  if (per > 0.34)
+    text += ". Substeps longer than about a third of t_c let a collisional flow's contacts act "
+            "as enduring ones, and its heaps and flows come out steeper and less mobile than the "
+            "law's";
   logmesg(lmp, text + " (doc page, \"Time step and stiff materials\")\n");
   return n;
 }

@@ -358,7 +358,7 @@ std::string describe(const Settings &s)
   out += ", substeps " +
          (s.model.substeps > 0
               ? std::to_string(s.model.substeps)
-              : "auto (at most " + format_g(s.model.substep_collisions) + " collision times each)");
+              : "auto (at most " + format_g(s.model.substep_collisions) + " t_c each)");
   const FrictionParams &f = s.model.friction;
   return out + ", mu " + format_g(f.mu) + ", mu_roll " + format_g(f.mu_roll) + ", mu_twist " +
          format_g(f.mu_twist);

@@ -16,12 +16,13 @@ using namespace fibre;
 TEST(Substeps, AsManyAsTheCollisionTimeAsks)
 {
   ContactModel model;
-  // automatic: the fewest of at most half the collision time (the material deck at E = 1e8:
-  // its step is 4.95 t_c)
-  EXPECT_EQ(substeps_for(model, 4.4343e-3, 8.96051e-4), 10);
-  EXPECT_EQ(substeps_for(model, 1.0, 1.0), 2); // exactly 0.5 t_c each
-  EXPECT_EQ(substeps_for(model, 0.3, 1.0), 1); // the step resolves the collisions already
-  EXPECT_EQ(substeps_for(model, 1.0, 0.0), 1); // no elastic law
+  // automatic: the fewest of at most 0.33 collision times (the material deck's step is 0.31,
+  // 1.49 and 4.95 t_c at E = 1e5, 5e6 and 1e8)
+  EXPECT_EQ(substeps_for(model, 4.4343e-3, 8.96051e-4), 15);
+  EXPECT_EQ(substeps_for(model, 1.49, 1.0), 5);
+  EXPECT_EQ(substeps_for(model, 0.312, 1.0), 1); // the step resolves the collisions already
+  EXPECT_EQ(substeps_for(model, 0.66, 1.0), 2);  // exactly 0.33 t_c each
+  EXPECT_EQ(substeps_for(model, 1.0, 0.0), 1);   // no elastic law
   EXPECT_EQ(substeps_for(model, 1.0, 1e-9), kMaxSubsteps);
   model.substep_collisions = 0.25;
   EXPECT_EQ(substeps_for(model, 1.0, 1.0), 4);

@@ -71,7 +71,7 @@ struct ContactModel {
   // automatic, the fewest of at most substep_collisions shortest collision times of the
   // material's law (one where the step is that short already, or there is no law).
   int substeps = 0;
-  double substep_collisions = 0.5;
+  double substep_collisions = 0.33;
   CoefficientSource coefficients = CoefficientSource::pair;
   NormalRelaxation normal_relaxation = NormalRelaxation::spook;
   TypedCoefficients typed{};

@@ -3,7 +3,7 @@
 // motion, while the impulses, the bodies' velocities, the contacts' gaps and the elastic rows'
 // springs advance in n substeps of h / n. At a step longer than the collision time t_c a
 // collisional flow's contacts otherwise act as enduring ones (SPOOK relaxes a contact over
-// d steps, not over t_c), and its heaps come out steeper; n substeps of at most t_c / 2 give
+// d steps, not over t_c), and its heaps come out steeper; n substeps of about t_c / 3 give
 // the law's heap at a fraction of the cost of n steps (the step's fixed work is done once).
 #pragma once
 
