@@ -7,6 +7,7 @@
 #include "comm.h"
 #include "error.h"
 #include "host.h"
+#include "fibre/substeps.hpp"
 #include "fibre/system_io.hpp"
 #include "fibre/text.hpp"
 #include "memory.h"
@@ -185,6 +186,19 @@ void FibreOutput::add_work(const fibre::ContactWork &work)
   stats_[V_DISSIPATION] += sums[1];
 }
 
+void FibreOutput::report_check(const fibre::StepAccuracy &errors, bool reference_converged,
+                               int sweeps)
+{
+  stats_[V_CHECK_VELOCITY] = errors.velocity();
+  stats_[V_CHECK_IMPULSE] = errors.impulse();
+  if (reference_converged || comm->me != 0) return;
+  warn(error, FLERR,
+       "Fix fibre_contact: the check's converged step at step " +
+           std::to_string(static_cast<long long>(update->ntimestep)) + " did not reach " +
+           fibre::format_g(fibre::kCheckAccuracy) + " in " + std::to_string(sweeps) +
+           " sweeps; its errors (f_ID[19], f_ID[20]) are against that");
+}
+
 // Counters and the last step's figures.
 void FibreOutput::write_restart(FILE *fp) const
 {
@@ -203,6 +217,7 @@ void FibreOutput::read_restart(const char *buf)
 {
   const double *list = reinterpret_cast<const double *>(buf);
   const int values = list[0] == kRestartFormat ? V_SIZE
+                     : list[0] == 4.0          ? V_CHECK_VELOCITY
                      : list[0] == 3.0          ? V_WALL_WORK
                      : list[0] == 2.0          ? V_ERROR_ESTIMATE
                                                : 0;

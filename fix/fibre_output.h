@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "fibre/detection.hpp"
+#include "fibre/nonsmooth_reference.hpp"
 #include "fibre/spook.hpp"
 #include "fibre/step_solver.hpp"
 #include "fibre/stress.hpp"
@@ -33,17 +34,22 @@ enum Stat {
   V_SWEEPS,
   V_SWEEP_TIME,
   V_ERROR_ESTIMATE,
-  V_WALL_WORK,   // cumulative, since the fix was defined (kept across restarts)
-  V_DISSIPATION, // cumulative, likewise
+  V_WALL_WORK,      // cumulative, since the fix was defined (kept across restarts)
+  V_DISSIPATION,    // cumulative, likewise
+  V_CHECK_VELOCITY, // the last check's errors against the converged step (keyword check)
+  V_CHECK_IMPULSE,
   V_SIZE
 };
 
 class FibreOutput : protected LAMMPS_NS::Pointers {
  public:
   static constexpr int kLocalColumns = 8;
-  static constexpr double kRestartFormat = 4.0; // 4: 18 global values (3: 16, 2: 15, still read)
+  static constexpr double kRestartFormat = 5.0; // 5: 20 global values (4: 18, 3: 16, 2: 15)
 
-  explicit FibreOutput(LAMMPS_NS::LAMMPS *lmp) : Pointers(lmp) {}
+  explicit FibreOutput(LAMMPS_NS::LAMMPS *lmp) : Pointers(lmp)
+  {
+    stats_[V_CHECK_VELOCITY] = stats_[V_CHECK_IMPULSE] = -1.0; // no check yet
+  }
   ~FibreOutput() override;
 
   double stat(int n) const { return n >= 0 && n < V_SIZE ? stats_[n] : 0.0; }
@@ -64,6 +70,8 @@ class FibreOutput : protected LAMMPS_NS::Pointers {
   void report_solve(const fibre::StepResult &res);
   // Adds one step's work of the contacts (this process's contacts; summed here).
   void add_work(const fibre::ContactWork &work);
+  // A check's errors (keyword check), with a warning where its reference did not converge.
+  void report_check(const fibre::StepAccuracy &errors, bool reference_converged, int sweeps);
   // One row per contact: tags, wall, gap, |normal|, |friction|, |rolling|, |twisting| impulse.
   void fill_local(const std::vector<fibre::DetectedContact> &found, const fibre::Vector *lambda,
                   int rows, double **&array_local, int &size_local_rows);

@@ -29,6 +29,7 @@
 #include "fibre_detect.h"
 #include "fibre/spook.hpp"
 #include "fibre/stress.hpp"
+#include "fibre/nonsmooth_reference.hpp"
 #include "fibre/substeps.hpp"
 #include "fibre/text.hpp"
 #include "fibre_output.h"
@@ -542,11 +543,12 @@ void FixFibreContact::warn_deep_overlaps(const std::vector<fibre::Body> &bodies,
    state stays finite)
 ------------------------------------------------------------------------- */
 
-fibre::StepResult FixFibreContact::solve(fibre::ContactSystem &sys, const fibre::Vector &warm)
+fibre::StepResult FixFibreContact::solve(fibre::ContactSystem &sys, const fibre::Vector &warm,
+                                         const fibre::StepOptions &opt)
 {
   fibre::StepResult res;
   try {
-    res = fibre::solve_step(sys, *exchange_, settings_.step, &warm, world);
+    res = fibre::solve_step(sys, *exchange_, opt, &warm, world);
   } catch (std::exception &e) {
     fail_one(error, FLERR,
              std::string("Fix fibre_contact: contact solver failed at step ") +
@@ -569,6 +571,30 @@ fibre::StepResult FixFibreContact::solve(fibre::ContactSystem &sys, const fibre:
                " gave non-finite impulses; the step ignores the contacts");
   }
   return res;
+}
+
+/* ----------------------------------------------------------------------
+   the step's check (keyword check): its substeps again from the same start, converged, and
+   the run's summed impulses and velocity change against theirs
+------------------------------------------------------------------------- */
+
+void FixFibreContact::check_step(const fibre::Substeps &steps, int substeps,
+                                 const fibre::SpookParams &params, std::vector<fibre::Body> bodies,
+                                 std::vector<fibre::Contact> contacts, fibre::Vector warm)
+{
+  if (steps.result.dv.size() != steps.system.body_dofs()) return; // the run's solve failed
+  const fibre::StepOptions converged = fibre::check_options(settings_.step);
+  const fibre::Substeps ref = fibre::run_substeps(
+      substeps, settings_.model, params, m_min_, *exchange_, exchange_->num_owned(),
+      std::move(bodies), std::move(contacts), std::move(warm),
+      [this, &converged](fibre::ContactSystem &s, const fibre::Vector &w, bool) {
+        return solve(s, w, converged);
+      });
+  if (ref.result.dv.size() != ref.system.body_dofs() || ref.lambda.size() != steps.lambda.size())
+    return; // solve() has warned
+  const fibre::StepAccuracy errors =
+      fibre::step_accuracy(steps.system, steps.lambda, ref.lambda, *exchange_);
+  output_->report_check(errors, ref.totals.converged, ref.totals.sweeps);
 }
 
 /* ----------------------------------------------------------------------
@@ -624,65 +650,65 @@ void FixFibreContact::final_integrate()
   const bool do_export =
       settings_.export_every > 0 && update->ntimestep % settings_.export_every == 0;
 
-  // build (a step without contacts anywhere is free flight: an empty system and result)
+  // build and solve (a step without contacts anywhere is free flight: an empty system)
   std::vector<fibre::Contact> contacts;
   contacts.reserve(found.size());
   for (const fibre::DetectedContact &fc : found) contacts.push_back(fc.contact);
-  fibre::Vector warm = history_.warm_start(found, model.rows, hs);
-  history_.load_springs(found, contacts);
-  // substeps 1 .. n - 1; the last one is the step's system below, as without substeps
-  fibre::Substeps earlier;
-  if (any && substeps > 1)
-    earlier = fibre::run_substeps(
-        substeps, model, params, m_min_, *exchange_, exchange_->num_owned(), bodies, contacts, warm,
-        [this](fibre::ContactSystem &s, const fibre::Vector &w) { return solve(s, w); });
-  const fibre::Vector warm_last = warm;
-  if (any) fibre::apply_contact_model(model, params, m_min_, bodies, contacts, &warm_last);
-  fibre::ContactSystem sys(std::move(bodies), std::move(contacts), model.rows, params,
-                           exchange_->num_owned());
-
-  // solve and apply
-  fibre::StepResult res;
-  if (any) res = solve(sys, warm_last);
-  const bool substepped = earlier.done > 0 && res.dv.size() == earlier.dv.size();
-  // the step's impulses (the substeps' sum) and velocity change
-  const fibre::Vector lambda_step =
-      substepped ? fibre::Vector(earlier.lambda + res.lambda) : res.lambda;
-  if (substepped) {
-    const fibre::Vector dv_step = earlier.dv + res.dv;
-    update_velocities(&dv_step);
+  fibre::Substeps steps;
+  if (any) {
+    fibre::Vector warm = history_.warm_start(found, model.rows, hs);
+    history_.load_springs(found, contacts);
+    const bool check = settings_.check_every > 0 && update->ntimestep % settings_.check_every == 0;
+    std::vector<fibre::Body> bodies_at_start;
+    std::vector<fibre::Contact> contacts_at_start;
+    fibre::Vector warm_at_start;
+    if (check) {
+      bodies_at_start = bodies;
+      contacts_at_start = contacts;
+      warm_at_start = warm;
+    }
+    fibre::StepOptions inner = settings_.step;
+    inner.residual = false; // only the last substep's residual is reported
+    steps = fibre::run_substeps(
+        substeps, model, params, m_min_, *exchange_, exchange_->num_owned(), std::move(bodies),
+        std::move(contacts), std::move(warm),
+        [this, &inner](fibre::ContactSystem &s, const fibre::Vector &w, bool last) {
+          return solve(s, w, last ? settings_.step : inner);
+        });
+    if (check)
+      check_step(steps, substeps, params, std::move(bodies_at_start), std::move(contacts_at_start),
+                 std::move(warm_at_start));
   } else {
-    update_velocities(res.dv.size() > 0 ? &res.dv : nullptr);
+    steps.system = fibre::ContactSystem(std::move(bodies), std::move(contacts), model.rows, params,
+                                        exchange_->num_owned());
   }
+  const fibre::ContactSystem &sys = steps.system;
+  const fibre::StepResult &res = steps.result;
+
+  // apply: the step's impulses and velocity change are the substeps' sums
+  const bool solved = any && res.dv.size() == sys.body_dofs();
+  const bool substepped = solved && steps.done > 1;
+  update_velocities(solved ? &steps.dv : nullptr);
   // the loads and the virial of the step's mean force (sys's step is a substep's)
   const fibre::Vector lambda_mean =
-      substepped ? fibre::Vector(lambda_step / double(earlier.done + 1)) : res.lambda;
+      substepped ? fibre::Vector(steps.lambda / double(steps.done)) : res.lambda;
   tally_wall_loads(sys, found, lambda_mean);
   if (evflag) // this step's virial is wanted (post_force)
     tally_virial(sys, lambda_mean.size() ? lambda_mean : fibre::Vector::Zero(sys.contact_dofs()));
-  // the elastic rows' springs (compliance material) and the energy the moving walls put in and
-  // the contacts take out, both from the velocities after the step (collective: every process)
-  std::vector<std::array<double, fibre::kMaxRows>> springs;
-  if (any) {
-    const fibre::Vector v_plus = fibre::velocities_after_change(sys, *exchange_, res.dv);
-    if (model.compliance.material) springs = fibre::advance_springs(sys, v_plus, res.lambda);
-    fibre::ContactWork work = fibre::contact_work(sys, v_plus, res.lambda);
-    if (substepped) {
-      work.wall_work += earlier.work.wall_work;
-      work.dissipation += earlier.work.dissipation;
-      follow_substeps(earlier.path + v_plus, earlier.done + 1, hs);
-    }
-    output_->add_work(work);
+  // the energy the moving walls put in and the contacts take out
+  if (solved) {
+    if (substepped) follow_substeps(steps.path, steps.done, hs);
+    output_->add_work(steps.work);
   }
+  // the history: the last substep's impulses and (compliance material) its springs
   overflow_count_ += history_.store(found, res.lambda, model.rows, hs, atom->nlocal,
-                                    springs.empty() ? nullptr : &springs);
+                                    steps.springs.empty() ? nullptr : &steps.springs);
 
   // report
-  output_->fill_local(found, any ? &lambda_step : nullptr, model.rows, array_local,
+  output_->fill_local(found, solved ? &steps.lambda : nullptr, model.rows, array_local,
                       size_local_rows);
-  if (substepped) {
-    fibre::StepResult all = earlier.totals;
-    fibre::add_solve(all, res);
+  if (steps.done > 1) {
+    fibre::StepResult all = steps.totals;
     all.iterations = res.iterations;
     all.rel_residual = res.rel_residual;
     all.fibres = res.fibres;
@@ -692,7 +718,7 @@ void FixFibreContact::final_integrate()
   }
   if (do_export) // with substeps, the last one's system and warm start
     output_->export_step(settings_.export_prefix, sys, found, any ? &res.lambda : nullptr,
-                         warm_last, exchange_->local_owners());
+                         steps.warm, exchange_->local_owners());
   if (overflow_count_ > 0 && !overflow_warned_ && comm->me == 0) {
     warn(error, FLERR,
          "Fix fibre_contact: more than " + std::to_string(fibre::ContactHistory::kMaxSlots) +

@@ -10,6 +10,7 @@
 
 #include "fibre/contact_history.hpp"
 #include "fibre/settings.hpp"
+#include "fibre/substeps.hpp"
 #include "fix.h"
 
 namespace fibre_lmp {
@@ -79,7 +80,11 @@ class FixFibreContact : public Fix {
   void tally_virial(const fibre::ContactSystem &sys, const fibre::Vector &lambda);
   void warn_deep_overlaps(const std::vector<fibre::Body> &bodies,
                           const std::vector<fibre::DetectedContact> &found, double max_recovery);
-  fibre::StepResult solve(fibre::ContactSystem &sys, const fibre::Vector &warm);
+  fibre::StepResult solve(fibre::ContactSystem &sys, const fibre::Vector &warm,
+                          const fibre::StepOptions &opt);
+  void check_step(const fibre::Substeps &steps, int substeps, const fibre::SpookParams &params,
+                  std::vector<fibre::Body> bodies, std::vector<fibre::Contact> contacts,
+                  fibre::Vector warm);
   void update_velocities(const fibre::Vector *dv);
 
   fibre::Settings settings_;

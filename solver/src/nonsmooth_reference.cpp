@@ -102,6 +102,8 @@ StepAccuracy step_accuracy(const ContactSystem &sys, const Vector &lambda, const
     g[k][0] += (lambda[i] - ref[i]) * (lambda[i] - ref[i]);
     g[k][1] += ref[i] * ref[i];
   }
+  ex.sum(&e[0][0], 4);
+  ex.sum(&g[0][0], 8);
   // A group whose reference is (numerically) empty, such as twisting with mu_twist 0, is
   // measured against the normal impulses instead of against its own round-off.
   const double floor2 = 1e-24 * g[0][1];

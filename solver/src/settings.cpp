@@ -306,13 +306,18 @@ Settings parse_settings(const std::vector<std::string> &args)
       s.export_prefix = args[i + 2];
       used = 3;
     }
+    if (!used && key == "check") {
+      s.check_every = static_cast<int>(
+          in.integer(i + 1, "'check <N>' (N a non-negative integer)", 0, 2000000000L));
+      used = 2;
+    }
     if (!used)
       Reader::illegal(
           "a keyword (form, solver, precond, weight, tol, linear_tol, pass_tol, maxiter, "
           "compliance, damping, mu, mu_roll, mu_twist, rows, active_set, sweeps, "
           "sweep_tol, rescue_sweeps, min_sweeps, focus_sweeps, anderson, anderson_period, "
           "sweep_cg, sweep_blocks, sweep_groups, recovery_speed, restitution, bounce_speed, "
-          "coefficients, normal_relaxation, substeps, substep_collisions, wall, export)",
+          "coefficients, normal_relaxation, substeps, substep_collisions, wall, export, check)",
           &key);
     i += used;
   }

@@ -136,13 +136,16 @@ ContactWork contact_work(const ContactSystem &sys, const Vector &v_plus, const V
   return work;
 }
 
-std::vector<std::array<double, kMaxRows>>
-advance_springs(const ContactSystem &sys, const Vector &v_plus, const Vector &lambda)
+std::vector<std::array<double, kMaxRows>> advance_springs(const ContactSystem &sys,
+                                                          const Vector &v_plus,
+                                                          const Vector &lambda,
+                                                          const Vector *Gv_plus)
 {
   const int rows = sys.rows(), nc = sys.num_contacts();
   std::vector<std::array<double, kMaxRows>> springs(nc);
-  Vector Gv, Gv0; // Gv0: G v at the step's start, for the springs with a damper of their own
-  g_apply(sys, v_plus, Gv);
+  Vector own, Gv0; // Gv0: G v at the step's start, for the springs with a damper of their own
+  if (!Gv_plus) g_apply(sys, v_plus, own);
+  const Vector &Gv = Gv_plus ? *Gv_plus : own;
   const Cones cones(sys);
   const double h = sys.params().h;
   for (int c = 0; c < nc; ++c) {

@@ -304,6 +304,9 @@ void StepSolver::finish(Vector &lambda, StepResult &res) const
     control.nonlinear_cg = opt_.sweep_cg || opt_.solver == Method::nncg;
     control.fibre_blocks = opt_.sweep_blocks || opt_.solver == Method::fbgs;
     control.block_weight = opt_.precond.weight;
+    // the residual decides the rescue and the restart, except under the accuracy rule with a
+    // sweeps-only solver
+    const bool measured = opt_.residual || !accuracy || !sweeps_only();
     const auto sweep = [&]() {
       const PgsResult pr = opt_.solver == Method::apgd
                                ? apgd(sys_, ex_, cones_, b_full_, scale, lambda, control)
@@ -312,7 +315,8 @@ void StepSolver::finish(Vector &lambda, StepResult &res) const
       res.sweep_equivalents += nc_ > 0 ? double(pr.visits) / nc_ : 0.0;
       res.sweep_reason = pr.reason;
       res.error_estimate = pr.reported_estimate();
-      res.complementarity = complementarity(sys_, ex_, cones_, b_full_, lambda, scale);
+      res.complementarity =
+          measured ? complementarity(sys_, ex_, cones_, b_full_, lambda, scale) : kNotMeasured;
     };
     sweep();
     // far from sweep_tol at the cap: sweep on (collective: every process sees the residual);

@@ -15,6 +15,17 @@ int substeps_for(const ContactModel &model, double h, double t_c)
   return static_cast<int>(std::clamp(n, 1.0, double(kMaxSubsteps)));
 }
 
+StepOptions check_options(const StepOptions &step)
+{
+  StepOptions ref = step;
+  ref.solver = Method::pgs;
+  ref.accuracy = kCheckAccuracy;
+  ref.sweeps = kCheckSweeps;
+  ref.focus_sweeps = 0;
+  ref.residual = true;
+  return ref;
+}
+
 void add_solve(StepResult &into, const StepResult &more)
 {
   into.total_iterations += more.total_iterations;
@@ -34,48 +45,61 @@ void add_solve(StepResult &into, const StepResult &more)
 }
 
 Substeps run_substeps(int n, const ContactModel &model, const SpookParams &params, double m_min,
-                      const Exchange &ex, int num_owned, std::vector<Body> &bodies,
-                      std::vector<Contact> &contacts, Vector &warm, const SubstepSolve &solve)
+                      const Exchange &ex, int num_owned, std::vector<Body> bodies,
+                      std::vector<Contact> contacts, Vector warm, const SubstepSolve &solve)
 {
   Substeps out;
   const double h = params.h;
   const int rows = model.rows;
-  for (int sub = 1; sub < n; ++sub) {
-    std::vector<Contact> modelled = contacts; // the model rewrites compliances and restitution
-    apply_contact_model(model, params, m_min, bodies, modelled, &warm);
-    ContactSystem sys(bodies, std::move(modelled), rows, params, num_owned);
-    StepResult res = solve(sys, warm);
-    if (res.dv.size() != sys.body_dofs()) break;
-    const Vector v_plus = velocities_after_change(sys, ex, res.dv);
-    std::vector<std::array<double, kMaxRows>> springs;
-    if (model.compliance.material) springs = advance_springs(sys, v_plus, res.lambda);
-    const ContactWork work = contact_work(sys, v_plus, res.lambda);
+  apply_contact_model(model, params, m_min, bodies, contacts, &warm);
+  out.system = ContactSystem(std::move(bodies), std::move(contacts), rows, params, num_owned);
+  ContactSystem &sys = out.system;
+  for (int sub = 1; sub <= n; ++sub) {
+    const bool last = sub == n;
+    if (sub > 1) { // the last substep's motion and springs, then the model at its impulses
+      Vector Gv;
+      g_apply(sys, out.v_plus, Gv);
+      std::vector<std::array<double, kMaxRows>> springs;
+      if (model.compliance.material) springs = advance_springs(sys, out.v_plus, warm, &Gv);
+      const Vector &v_plus = out.v_plus;
+      sys.next_substep([&](std::vector<Body> &b, std::vector<Contact> &c) {
+        for (std::size_t k = 0; k < c.size(); ++k) {
+          c[k].gap += h * (Gv[Eigen::Index(rows) * Eigen::Index(k)] - wall_rows(c[k])[0]);
+          if (!springs.empty()) c[k].spring = springs[k];
+        }
+        for (std::size_t i = 0; i < b.size(); ++i) {
+          b[i].v = v_plus.segment<3>(6 * Eigen::Index(i));
+          b[i].omega = v_plus.segment<3>(6 * Eigen::Index(i) + 3);
+        }
+        apply_contact_model(model, params, m_min, b, c, &warm);
+      });
+    }
+    out.warm = warm;
+    StepResult res = solve(sys, warm, last);
+    const bool solved = res.dv.size() == sys.body_dofs();
+    if (out.done == 0)
+      out.totals = res;
+    else
+      add_solve(out.totals, res);
+    ++out.done;
+    out.result = std::move(res);
+    if (!solved) break;
+    const StepResult &r = out.result;
+    out.v_plus = velocities_after_change(sys, ex, r.dv);
+    if (last && model.compliance.material) out.springs = advance_springs(sys, out.v_plus, r.lambda);
+    const ContactWork work = contact_work(sys, out.v_plus, r.lambda);
     out.work.wall_work += work.wall_work;
     out.work.dissipation += work.dissipation;
-    Vector Gv;
-    g_apply(sys, v_plus, Gv);
-    for (std::size_t c = 0; c < contacts.size(); ++c) {
-      const Contact &k = sys.contacts()[c];
-      contacts[c].gap += h * (Gv[Eigen::Index(rows) * Eigen::Index(c)] - wall_rows(k)[0]);
-      if (!springs.empty()) contacts[c].spring = springs[c];
-    }
-    for (std::size_t i = 0; i < bodies.size(); ++i) {
-      bodies[i].v = v_plus.segment<3>(6 * Eigen::Index(i));
-      bodies[i].omega = v_plus.segment<3>(6 * Eigen::Index(i) + 3);
-    }
-    if (out.done == 0) {
-      out.dv = res.dv;
-      out.path = v_plus;
-      out.lambda = res.lambda;
-      out.totals = res;
+    if (out.done == 1) {
+      out.dv = r.dv;
+      out.path = out.v_plus;
+      out.lambda = r.lambda;
     } else {
-      out.dv += res.dv;
-      out.path += v_plus;
-      out.lambda += res.lambda;
-      add_solve(out.totals, res);
+      out.dv += r.dv;
+      out.path += out.v_plus;
+      out.lambda += r.lambda;
     }
-    warm = res.lambda;
-    ++out.done;
+    warm = r.lambda;
   }
   return out;
 }

@@ -1,5 +1,6 @@
 #include "fibre/system.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 #include <string>
@@ -151,7 +152,13 @@ void ContactSystem::set_row_mask(const std::vector<unsigned char> &active)
 {
   if (static_cast<Eigen::Index>(active.size()) != contact_dofs())
     throw std::invalid_argument("row mask size differs from the number of contact rows");
-  mask_ = active;
+  const bool all_active =
+      std::all_of(active.begin(), active.end(), [](unsigned char m) { return m != 0; });
+  if (all_active && mask_.empty()) return; // nothing changes
+  if (all_active)
+    mask_.clear();
+  else
+    mask_ = active;
   compute_rows();
   for (Eigen::Index row = 0; row < contact_dofs(); ++row)
     if (!row_active(row)) rhs_[row] = 0.0;

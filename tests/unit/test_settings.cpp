@@ -57,6 +57,7 @@ TEST(Settings, NoKeywordsKeepTheDefaults)
   EXPECT_DOUBLE_EQ(s.model.compliance.factor, 1e-2);
   EXPECT_TRUE(s.walls.empty());
   EXPECT_EQ(s.export_every, 0);
+  EXPECT_EQ(s.check_every, 0);
   EXPECT_EQ(
       describe(s),
       "form body, solver pgs, precond tree, weight z, tol 0.0001, linear_tol 0.0001, pass_tol "
@@ -76,7 +77,7 @@ TEST(Settings, EveryKeywordSetsWhatItNames)
             "pass_tol 1e-5 tol 2e-3 maxiter 77 compliance 1e-7 2e-7 damping 3 mu 0.3 mu_roll 0.1 "
             "mu_twist 0.05 rows 6 "
             "active_set 4 sweeps 9 sweep_tol 1e-4 wall zplane 0 NULL wall xplane -1 1 "
-            "wall region box export 10 out/sys"));
+            "wall region box export 10 out/sys check 25"));
   EXPECT_EQ(s.step.form, Form::contact);
   EXPECT_EQ(s.step.solver, Method::cg); // uzawa is an alias
   EXPECT_EQ(s.step.precond.kind, PrecondKind::fibre);
@@ -111,6 +112,7 @@ TEST(Settings, EveryKeywordSetsWhatItNames)
   EXPECT_TRUE(mesh.walls[1].is_plane());
   EXPECT_EQ(s.export_every, 10);
   EXPECT_EQ(s.export_prefix, "out/sys");
+  EXPECT_EQ(s.check_every, 25);
   EXPECT_NE(describe(s).find("compliance 1e-07 2e-07"), std::string::npos);
   EXPECT_EQ(parse_settings(words("solver pgs")).step.solver, Method::pgs);
   EXPECT_EQ(parse_settings(words("solver fbgs")).step.solver, Method::fbgs);
@@ -216,6 +218,8 @@ TEST(Settings, BadInputNamesTheKeywordAndItsForm)
             "expected 'wall xplane|yplane|zplane <lo|NULL> <hi|NULL>', 'wall region <region-ID>' "
             "or 'wall mesh <fix-ID>', got 'cylinder'");
   EXPECT_EQ(error_of("export 10"), "expected 'export <N> <file-prefix>' (N a positive integer)");
+  EXPECT_EQ(error_of("check -1"), "expected 'check <N>' (N a non-negative integer), got '-1'");
+  EXPECT_EQ(error_of("check"), "expected 'check <N>' (N a non-negative integer)");
   EXPECT_EQ(error_of("anderson 51"), "expected 'anderson <integer 0 to 50>', got '51'");
   EXPECT_EQ(error_of("anderson_period 0"),
             "expected 'anderson_period <integer 1 to 100>', got '0'");

@@ -44,7 +44,7 @@ ContactModel compliant_model(double eps)
   return model;
 }
 
-StepResult solve(ContactSystem &sys, const Vector &warm)
+StepResult solve(ContactSystem &sys, const Vector &warm, bool = true)
 {
   StepOptions opt; // the fix's defaults, solved tighter than they stop
   opt.stop.tol = 1e-12;
@@ -52,9 +52,9 @@ StepResult solve(ContactSystem &sys, const Vector &warm)
   return solve_step(sys, serial_exchange(), opt, &warm, MPI_COMM_SELF);
 }
 
-// The last substep as the fix does it: the model, the system, the solve; returns v+.
-Vector last_substep(const ContactModel &model, const SpookParams &params, std::vector<Body> bodies,
-                    std::vector<Contact> contacts, const Vector &warm, Vector &lambda)
+// One step as the fix did it before substeps: the model, the system, the solve; returns v+.
+Vector one_step(const ContactModel &model, const SpookParams &params, std::vector<Body> bodies,
+                std::vector<Contact> contacts, const Vector &warm, Vector &lambda)
 {
   apply_contact_model(model, params, 1.0, bodies, contacts, &warm);
   ContactSystem sys(std::move(bodies), std::move(contacts), model.rows, params);
@@ -90,21 +90,17 @@ TEST(Substeps, AreStepsOfTheirLengthWhereTheGeometryHolds)
   // the substeps, with the contact detected once
   std::vector<Body> bodies = start;
   std::vector<Contact> contacts{sphere_sphere_contact(bodies, 1, 0)};
-  Vector warm = Vector::Zero(3);
-  const Substeps earlier =
-      run_substeps(n, model, params, 1.0, serial_exchange(), 2, bodies, contacts, warm, solve);
-  ASSERT_EQ(earlier.done, n - 1);
-  Vector lambda_last;
-  const Vector v_final = last_substep(model, params, bodies, contacts, warm, lambda_last);
-  const Vector impulse = earlier.lambda + lambda_last;
-  const Vector path = earlier.path + v_final;
+  const Substeps steps = run_substeps(n, model, params, 1.0, serial_exchange(), 2, bodies, contacts,
+                                      Vector::Zero(3), solve);
+  ASSERT_EQ(steps.done, n);
+  const Vector &v_final = steps.v_plus, &impulse = steps.lambda, &path = steps.path;
 
   // the reference: n steps of hs, positions moved and the contact rebuilt each step
   std::vector<Body> ref = start;
   Vector ref_warm = Vector::Zero(3), ref_impulse = Vector::Zero(3), ref_v;
   for (int k = 0; k < n; ++k) {
     Vector lambda;
-    ref_v = last_substep(model, params, ref, {sphere_sphere_contact(ref, 1, 0)}, ref_warm, lambda);
+    ref_v = one_step(model, params, ref, {sphere_sphere_contact(ref, 1, 0)}, ref_warm, lambda);
     ref_impulse += lambda;
     ref_warm = lambda;
     for (int b = 0; b < 2; ++b) {
@@ -144,13 +140,55 @@ TEST(Substeps, CarryARestingSpheresWeightOverTheStep)
   // the warm start of a sphere that has rested there: its weight over a substep
   Vector warm = Vector::Zero(3);
   warm[0] = g * bodies[0].mass * params.h;
-  const Substeps earlier =
+  const Substeps steps =
       run_substeps(n, model, params, 1.0, serial_exchange(), 1, bodies, contacts, warm, solve);
-  ASSERT_EQ(earlier.done, n - 1);
-  Vector lambda_last;
-  const Vector v_final = last_substep(model, params, bodies, contacts, warm, lambda_last);
+  ASSERT_EQ(steps.done, n);
   const double weight_impulse = g * 2.0 * h;
-  EXPECT_NEAR(earlier.lambda[0] + lambda_last[0], weight_impulse, 1e-8 * weight_impulse);
-  EXPECT_LT(v_final.norm(), 1e-8 * g * h);
-  EXPECT_LT(std::abs(earlier.path[2]), 1e-8 * g * h);
+  EXPECT_NEAR(steps.lambda[0], weight_impulse, 1e-8 * weight_impulse);
+  EXPECT_LT(steps.v_plus.norm(), 1e-8 * g * h);
+  EXPECT_LT(std::abs(steps.path[2]), 1e-8 * g * h);
+}
+
+// One substep is the plain step, bit for bit, and the substeps before the last skip the
+// residual they are told to skip: the step reports the last one's.
+TEST(Substeps, OneIsThePlainStepAndOnlyTheLastMeasuresItsResidual)
+{
+  const double h = 0.01;
+  const ContactModel model = compliant_model(1e-6);
+  SpookParams params;
+  params.h = h;
+  std::vector<Body> bodies(2);
+  bodies[0].radius = bodies[1].radius = 0.5;
+  bodies[1].x = Vec3(0.99, 0, 0);
+  bodies[0].v = Vec3(1, 0, 0);
+  bodies[0].force = Vec3(0, 0, -9.81);
+  const std::vector<Contact> contacts{sphere_sphere_contact(bodies, 1, 0)};
+  Vector lambda;
+  const Vector v_plus = one_step(model, params, bodies, contacts, Vector::Zero(3), lambda);
+  const Substeps one = run_substeps(1, model, params, 1.0, serial_exchange(), 2, bodies, contacts,
+                                    Vector::Zero(3), solve);
+  ASSERT_EQ(one.done, 1);
+  EXPECT_EQ(one.lambda, lambda);
+  EXPECT_EQ(one.v_plus, v_plus);
+  EXPECT_EQ(one.result.lambda, lambda);
+
+  const auto skipping = [](ContactSystem &sys, const Vector &warm, bool last) {
+    StepOptions opt;
+    opt.residual = last;
+    return solve_step(sys, serial_exchange(), opt, &warm, MPI_COMM_SELF);
+  };
+  params.h = h / 4;
+  std::vector<double> residuals;
+  const Substeps four =
+      run_substeps(4, model, params, 1.0, serial_exchange(), 2, bodies, contacts, Vector::Zero(3),
+                   [&](ContactSystem &sys, const Vector &warm, bool last) {
+                     const StepResult r = skipping(sys, warm, last);
+                     residuals.push_back(r.complementarity);
+                     return r;
+                   });
+  ASSERT_EQ(four.done, 4);
+  ASSERT_EQ(residuals.size(), 4u);
+  for (int k = 0; k < 3; ++k) EXPECT_EQ(residuals[k], kNotMeasured);
+  EXPECT_GE(residuals[3], 0.0);
+  EXPECT_EQ(four.totals.complementarity, residuals[3]);
 }

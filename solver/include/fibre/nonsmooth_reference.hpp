@@ -23,8 +23,9 @@ struct StepAccuracy {
   double impulse() const; // the largest of the impulse groups that carry any impulse
 };
 
-// lambda against the reference ref (both rows per contact of sys). `ex`: one process, with
-// the step's periodic images where it has them (ImageExchange); so below.
+// lambda against the reference ref (both rows per contact of sys), over all processes of `ex`
+// (collective): the step's periodic images where it has them (ImageExchange), or the front
+// ends' processes. The functions below are serial (one process).
 StepAccuracy step_accuracy(const ContactSystem &sys, const Vector &lambda, const Vector &ref,
                            const Exchange &ex = serial_exchange());
 

@@ -20,6 +20,7 @@ struct Settings {
   std::vector<WallSpec> walls;
   int export_every = 0; // write the step's system every N steps (0: never)
   std::string export_prefix;
+  int check_every = 0; // solve the step again converged every N steps (0: never)
 };
 
 // What follows "Illegal fix fibre_contact command: " in the front end's error.

@@ -52,8 +52,10 @@ ContactWork contact_work(const ContactSystem &sys, const Vector &v_plus, const V
 // damper of its own (Contact::damper_time tau = gamma / k: SDS rolling and twisting) keeps that
 // less the damper's share, tau G v+, as LAMMPS's SDS laws do, less what SPOOK's row already
 // takes from its slowing. Zero on rows that are not elastic. v_plus: velocities_after(sys, ex,
-// lambda).
-std::vector<std::array<double, kMaxRows>>
-advance_springs(const ContactSystem &sys, const Vector &v_plus, const Vector &lambda);
+// lambda). Gv_plus: G v_plus where the caller has it.
+std::vector<std::array<double, kMaxRows>> advance_springs(const ContactSystem &sys,
+                                                          const Vector &v_plus,
+                                                          const Vector &lambda,
+                                                          const Vector *Gv_plus = nullptr);
 
 } // namespace fibre

@@ -87,9 +87,14 @@ struct StepOptions {
   // sweep_groups.hpp; where the processor has AVX2 and FMA): the same sweeps in another order,
   // at half the time a sweep (bench/README.md, "Sweeps four contacts at a time").
   bool sweep_groups = true;
+  // Whether the result measures its complementarity residual (StepResult::complementarity).
+  // Substeps before a step's last skip it where it decides nothing (the accuracy rule with a
+  // sweeps-only solver): it costs two products with G, and only the last one is reported.
+  bool residual = true;
 };
 
 inline constexpr double kRescueFactor = 10.0;
+inline constexpr double kNotMeasured = -1.0; // StepResult::complementarity not measured
 
 // The settings as one line, "name value, name value, ..." (PETSc KSPView style): the front
 // ends log it, and the doc page's defaults are this line for StepOptions{}.
@@ -111,7 +116,8 @@ struct StepResult {
   int released = 0;          // contacts with zero impulse at the end (lambda_n < 0)
   int capped = 0;            // friction/rolling/twisting rows on their cone boundary
   // Relative residual of the contact conditions at the final lambda (see complementarity()
-  // in contact_solver.cpp): 0 for an exact solution of the nonsmooth step.
+  // in contact_solver.cpp): 0 for an exact solution of the nonsmooth step, -1 where it was not
+  // measured (StepOptions::residual).
   double complementarity = 0;
   int sweeps = 0; // projected Gauss-Seidel sweeps done after the loop, rescue included
   // Their cost in full sweeps: contacts visited over this process's contacts (focused sweeps

@@ -23,32 +23,47 @@ namespace fibre {
 inline constexpr int kMaxSubsteps = 1000;
 int substeps_for(const ContactModel &model, double h, double t_c);
 
-// What the substeps before the last one did. The caller builds the last substep's system from
-// the bodies and contacts that run_substeps left, solves it as a plain step (its impulses and
-// springs go to the contact history) and adds it in.
+// What a step's substeps did: the last one's system and solve, and the sums over all.
 struct Substeps {
-  int done = 0;      // substeps run (n - 1, or fewer where a solve gave no result)
-  Vector dv;         // their contact velocity changes, summed (owned bodies and ghosts)
-  Vector path;       // the bodies' velocities after each of them, summed (6 per body)
-  Vector lambda;     // their impulses, summed (rows per contact)
-  ContactWork work;  // their contacts' work, summed (this process's contacts)
-  StepResult totals; // their sweeps, iterations and seconds, summed; converged if all were
+  // The last substep's system (its bodies at that substep's start) and solve; the step's
+  // contact history takes its impulses and springs. A solve without dv ended the substeps (a
+  // front end's failure): then the step ignores its contacts, and nothing below it is set.
+  ContactSystem system;
+  StepResult result;
+  Vector warm;   // the last substep's warm start
+  Vector v_plus; // the bodies' velocities after it (owned bodies and ghosts)
+  std::vector<std::array<double, kMaxRows>> springs; // its advanced springs (compliance material)
+  int done = 0;                                      // substeps run
+  Vector dv;         // the contacts' velocity changes, summed (owned bodies and ghosts)
+  Vector path;       // the bodies' velocities after each substep, summed (6 per body)
+  Vector lambda;     // the impulses, summed (rows per contact)
+  ContactWork work;  // the contacts' work, summed (this process's contacts)
+  StepResult totals; // sweeps, iterations and seconds, summed; converged if all were
 };
 
 // The solve of one substep's system from a warm start (a front end's: collective, it reports
-// failures); a result without dv ends the substeps.
-using SubstepSolve = std::function<StepResult(ContactSystem &, const Vector &warm)>;
+// failures); `last`: the step's last substep. A result without dv ends the substeps.
+using SubstepSolve = std::function<StepResult(ContactSystem &, const Vector &warm, bool last)>;
 
-// Runs substeps 1 .. n - 1 of length params.h (h / n) on `bodies` and `contacts` in place:
-// each applies the contact model (compliances and restitution from the last substep's
-// impulses), solves, and moves the bodies to their velocities after it, the gaps by
-// params.h G v+ (normals and contact points held for the step) and the elastic rows to their
-// advanced springs. `warm` is the first substep's warm start; on return it is the last run
-// substep's impulses, the next one's warm start. num_owned: the bodies [0, num_owned) owned
-// here (ContactSystem). Collective.
+// Runs the n substeps of length params.h (h / n) on one system built from `bodies` and
+// `contacts`: each applies the contact model (compliances and restitution from the last
+// substep's impulses), solves, and, before the last, moves the bodies to their velocities after
+// it, the gaps by params.h G v+ (normals and contact points held for the step) and the elastic
+// rows to their advanced springs. `warm` is the first substep's warm start, the last
+// substep's impulses the next one's. num_owned: the bodies [0, num_owned) owned here
+// (ContactSystem). Collective. With n = 1 it is the plain step.
 Substeps run_substeps(int n, const ContactModel &model, const SpookParams &params, double m_min,
-                      const Exchange &ex, int num_owned, std::vector<Body> &bodies,
-                      std::vector<Contact> &contacts, Vector &warm, const SubstepSolve &solve);
+                      const Exchange &ex, int num_owned, std::vector<Body> bodies,
+                      std::vector<Contact> contacts, Vector warm, const SubstepSolve &solve);
+
+// The reference of a step's check (Settings::check_every, keyword check): the step's own
+// options, its substeps' sweeps run on to an error estimate of kCheckAccuracy, at most
+// kCheckSweeps a substep. run_substeps with these from the step's start gives the converged
+// step, against which step_accuracy (nonsmooth_reference.hpp) measures the run's summed
+// impulses: the substeps share the step's G and M.
+inline constexpr double kCheckAccuracy = 1e-10;
+inline constexpr int kCheckSweeps = 20000;
+StepOptions check_options(const StepOptions &step);
 
 // Adds a later solve's counts and seconds to `into` (sweeps, iterations, seconds; the larger
 // error estimate and complementarity residual; converged only if both were).

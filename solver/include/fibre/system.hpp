@@ -218,9 +218,20 @@ class ContactSystem {
   const Vector &row_weight() const { return row_weight_; }
 
   // Active-set support: a masked row has a zero Jacobian row, Sigma 1 and rhs 0, so it is
-  // decoupled (its lambda solves to 0) while every block structure stays intact.
+  // decoupled (its lambda solves to 0) while every block structure stays intact. A mask with
+  // every row active is kept as none (empty): the kernels then skip the row weights.
   const std::vector<unsigned char> &row_mask() const { return mask_; }
   void set_row_mask(const std::vector<unsigned char> &active); // 1 = active row
+
+  // The next substep of a step (substeps.hpp), in place: the bodies' velocities and the
+  // contacts' gaps, springs, compliances and damping change; the bodies' positions and masses
+  // and the contacts' bodies, frames and points do not, so the kinematics hold. `edit` changes
+  // them; Sigma then follows the new compliances and damping.
+  template <typename Edit> void next_substep(Edit &&edit)
+  {
+    edit(bodies_, contacts_);
+    compute_rows();
+  }
   bool row_active(Eigen::Index row) const { return mask_.empty() || mask_[row] != 0; }
 
  private:
