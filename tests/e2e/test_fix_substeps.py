@@ -13,6 +13,7 @@ gravity, each sphere at v towards the other, at the decks' step of 4.43 ms (5 t_
 
 import os
 import re
+import shutil
 
 import fibre_e2e as e2e
 
@@ -60,7 +61,31 @@ def main():
                      "%.3g" % one)
             ck.check("Substeps longer than about a third of t_c" in one_run.output,
                      "v %g: substeps 1 at 5 t_c is warned of in the log" % v)
+    plastic_pour(args, ck)
     ck.close()
+
+
+def plastic_pour(args, ck):
+    """The material deck's pour at E = 1e8 without restitution (restitution 0): 15 substeps,
+    and no bounce anywhere, so detection must still reach as far as the impacts kick the
+    spheres. Before it did, a sphere that a plastic impact at 12.5 m/s kicked in the step's
+    first substep ran into a neighbour without a contact, and from step 385 on the overlaps grew
+    to 90% of a radius and spheres left the box. Its first 1.8 s (406 steps, 310 spheres)."""
+    source = os.path.join(args.source, "examples", "material")
+    for name in ("scene.material", "run.material"):
+        shutil.copy(os.path.join(source, name), args.workdir)
+    with open(os.path.join(source, "in.material")) as f:
+        deck = f.read()
+    run = e2e.run_lmp(args, deck, "plastic_pour", variables={
+        "N": 1400, "E": E, "tend": 1.8, "fc_extra": "restitution 0"})
+    if not ck.ran(run):
+        return
+    rows = [r for b in run.thermo for r in b]
+    deepest = max(r["f_fc[7]"] for r in rows)
+    ck.check(deepest < 0.0025, "a plastic stiff pour: the deepest overlap stays below 1% of the "
+             "smallest radius", "%.3g" % deepest)
+    ck.check(rows[-1]["Atoms"] == 310, "a plastic stiff pour: no sphere leaves the box",
+             "%d atoms" % rows[-1]["Atoms"])
 
 
 if __name__ == "__main__":
