@@ -1,7 +1,6 @@
 #include "fibre/settings.hpp"
 
 #include "fibre/substeps.hpp"
-
 #include "fibre/text.hpp"
 
 namespace fibre {
