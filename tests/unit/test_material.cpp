@@ -180,6 +180,18 @@ TEST(Material, ApplyContactModelPerType)
   apply_contact_model(model, step_of(1e-3), 1.0, bodies, contacts, &last);
   EXPECT_DOUBLE_EQ(contacts[0].restitution, 0.0);
   EXPECT_DOUBLE_EQ(contacts[2].restitution, 0.5);
+  // a load at round-off is none (a converged solve leaves 1e-16 where a trial impulse is
+  // zero): contact 0 approaching at 3 m/s (m_eff 0.5) stays an impact at 1e-16, not at 1e-6
+  bodies[0].v = Vec3(3, 0, 0);
+  contacts[0].normal = Vec3(-1, 0, 0); // from body 1 to body 0
+  last[0] = 1e-16;
+  apply_contact_model(model, step_of(1e-3), 1.0, bodies, contacts, &last);
+  EXPECT_DOUBLE_EQ(contacts[0].restitution, 0.5);
+  last[0] = 1e-6;
+  apply_contact_model(model, step_of(1e-3), 1.0, bodies, contacts, &last);
+  EXPECT_DOUBLE_EQ(contacts[0].restitution, 0.0);
+  bodies[0].v = Vec3::Zero();
+  contacts[0].normal = Vec3::UnitZ();
   model.typed = TypedCoefficients{};
   model.restitution = 0.0;
   // typed keywords override every pair; coefficients fix ignores the table

@@ -95,14 +95,18 @@ double effective_radius(const std::vector<Body> &bodies, const Contact &c);
 // Cone radius per unit normal impulse of cone k (0 Coulomb, 1 twisting, 2 rolling).
 double cone_coefficient(const FrictionParams &f, double r_eff, int cone);
 
+// A last normal impulse at most this times m_eff (|v_n| + bounce_speed) is round-off, no load.
+inline constexpr double kRoundoffLoad = 1e-9;
+
 // Sets the per-row compliance, the friction coefficients and the restitution of every contact
 // (m_min: the lightest body of the simulation, read by automatic compliance only). With
 // per-type coefficients a pair takes those of its bodies' types, a wall contact those of its
 // sphere's type with itself, and typed keywords override them.
 // `last` (optional, rows per contact) holds each contact's impulses of the last step, for
 // compliance material's reference load; a contact that carried a normal impulse then is an
-// enduring contact, not an impact, and gets no restitution. `params` gives the step h and the
-// bounce speed: an impact that bounces has its springs for its collision time only.
+// enduring contact, not an impact, and gets no restitution; one at round-off (kRoundoffLoad)
+// counts as none. `params` gives the step h and the bounce speed: an impact that bounces has
+// its springs for its collision time only.
 void apply_contact_model(const ContactModel &model, const SpookParams &params, double m_min,
                          const std::vector<Body> &bodies, std::vector<Contact> &contacts,
                          const Vector *last = nullptr);
