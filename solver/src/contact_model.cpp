@@ -22,6 +22,20 @@ double cone_coefficient(const FrictionParams &f, double r_eff, int cone)
 
 namespace {
 
+// The contact's reduced mass (the sphere's against a wall) and its bodies' approach speed along
+// the normal (> 0 closing; a wall at its own velocity).
+double effective_mass(const std::vector<Body> &bodies, const Contact &c)
+{
+  const double ma = bodies[c.a].mass;
+  return c.is_wall() ? ma : ma * bodies[c.b].mass / (ma + bodies[c.b].mass);
+}
+
+double normal_approach(const std::vector<Body> &bodies, const Contact &c)
+{
+  const Vec3 vb = c.is_wall() ? c.wall_v : bodies[c.b].v;
+  return -(bodies[c.a].v - vb).dot(c.normal);
+}
+
 // Contact c's coefficients from its type pair's (pc), and with compliance material its rows'
 // compliances, springs and damping.
 // A contact that bounces within the step touches for the law's collision time t_c only, at a
@@ -66,8 +80,7 @@ void apply_pair(const ContactModel &model, const PairCoefficients &pc, const Spo
   // (normal_relaxation spook, the default; law: see the end of this function). A
   // law without a dashpot is damped critically, tau = 2 sqrt(m_eff eps). Its springs keep at
   // least that critical damping (below). Bounces come from e (doc/design.md, session 17).
-  const double ma = bodies[c.a].mass;
-  const double m_eff = c.is_wall() ? ma : ma * bodies[c.b].mass / (ma + bodies[c.b].mass);
+  const double m_eff = effective_mass(bodies, c);
   double critical = 0.0;   // the normal row's, in steps
   double tau_n = INFINITY; // the normal row's damping time (seconds): the law's dashpot
   if (c.elastic[0]) {
@@ -93,11 +106,8 @@ void apply_pair(const ContactModel &model, const PairCoefficients &pc, const Spo
       c.damper_time[r] = tau;
     }
   }
-  if (force == 0) { // an impact, unless it approaches too slowly
-    const Vec3 vb = c.is_wall() ? c.wall_v : bodies[c.b].v;
-    const double approach = -(bodies[c.a].v - vb).dot(c.normal);
-    shorten_to_collision(pc, params, reff, m_eff, approach, floor, rows, c);
-  }
+  if (force == 0) // an impact, unless it approaches too slowly
+    shorten_to_collision(pc, params, reff, m_eff, normal_approach(bodies, c), floor, rows, c);
   // normal_relaxation law: where SPOOK would floor the law's dashpot at `damping` steps (a
   // stiff flow's enduring contacts then relaxed over 2 h, many times the law's time:
   // examples/README.md, "The constraints' relaxation time at a large step"), the normal row is
@@ -144,15 +154,8 @@ void apply_contact_model(const ContactModel &model, const SpookParams &params, d
     // spring in the converged step (session 42).
     const Eigen::Index normal = Eigen::Index(model.rows) * Eigen::Index(k);
     double last_normal = last && last->size() > normal ? std::max((*last)[normal], 0.0) : 0.0;
-    {
-      const Body &a = bodies[c.a];
-      const double mb = c.is_wall() ? 0.0 : bodies[c.b].mass;
-      const double m_eff = c.is_wall() ? a.mass : a.mass * mb / (a.mass + mb);
-      const Vec3 vb = c.is_wall() ? c.wall_v : bodies[c.b].v;
-      const double approach = std::abs((a.v - vb).dot(c.normal));
-      if (last_normal <= kRoundoffLoad * m_eff * (approach + params.bounce_speed))
-        last_normal = 0.0;
-    }
+    const double speed = std::abs(normal_approach(bodies, c)) + params.bounce_speed;
+    if (last_normal <= kRoundoffLoad * effective_mass(bodies, c) * speed) last_normal = 0.0;
     const int ta = bodies[c.a].type;
     const int tb = !c.is_wall() ? bodies[c.b].type : c.wall_type > 0 ? c.wall_type : ta;
     const int ntypes = model.materials.ntypes();
