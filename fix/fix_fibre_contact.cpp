@@ -544,11 +544,11 @@ void FixFibreContact::warn_deep_overlaps(const std::vector<fibre::Body> &bodies,
 ------------------------------------------------------------------------- */
 
 fibre::StepResult FixFibreContact::solve(fibre::ContactSystem &sys, const fibre::Vector &warm,
-                                         const fibre::StepOptions &opt)
+                                         const fibre::StepOptions &opt, fibre::SweepCache *cache)
 {
   fibre::StepResult res;
   try {
-    res = fibre::solve_step(sys, *exchange_, opt, &warm, world);
+    res = fibre::solve_step(sys, *exchange_, opt, &warm, world, cache);
   } catch (std::exception &e) {
     fail_one(error, FLERR,
              std::string("Fix fibre_contact: contact solver failed at step ") +
@@ -587,9 +587,8 @@ void FixFibreContact::check_step(const fibre::Substeps &steps, int substeps,
   const fibre::Substeps ref = fibre::run_substeps(
       substeps, settings_.model, params, m_min_, *exchange_, exchange_->num_owned(),
       std::move(bodies), std::move(contacts), std::move(warm),
-      [this, &converged](fibre::ContactSystem &s, const fibre::Vector &w, bool) {
-        return solve(s, w, converged);
-      });
+      [this, &converged](fibre::ContactSystem &s, const fibre::Vector &w, bool,
+                         fibre::SweepCache &cache) { return solve(s, w, converged, &cache); });
   if (ref.result.dv.size() != ref.system.body_dofs() || ref.lambda.size() != steps.lambda.size())
     return; // solve() has warned
   const fibre::StepAccuracy errors =
@@ -672,12 +671,12 @@ void FixFibreContact::final_integrate()
     }
     fibre::StepOptions inner = settings_.step;
     inner.residual = false; // only the last substep's residual is reported
-    steps = fibre::run_substeps(
-        substeps, model, params, m_min_, *exchange_, exchange_->num_owned(), std::move(bodies),
-        std::move(contacts), std::move(warm),
-        [this, &inner](fibre::ContactSystem &s, const fibre::Vector &w, bool last) {
-          return solve(s, w, last ? settings_.step : inner);
-        });
+    steps = fibre::run_substeps(substeps, model, params, m_min_, *exchange_, exchange_->num_owned(),
+                                std::move(bodies), std::move(contacts), std::move(warm),
+                                [this, &inner](fibre::ContactSystem &s, const fibre::Vector &w,
+                                               bool last, fibre::SweepCache &cache) {
+                                  return solve(s, w, last ? settings_.step : inner, &cache);
+                                });
     if (check)
       check_step(steps, substeps, params, std::move(bodies_at_start), std::move(contacts_at_start),
                  std::move(warm_at_start));

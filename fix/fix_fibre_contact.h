@@ -81,7 +81,7 @@ class FixFibreContact : public Fix {
   void warn_deep_overlaps(const std::vector<fibre::Body> &bodies,
                           const std::vector<fibre::DetectedContact> &found, double max_recovery);
   fibre::StepResult solve(fibre::ContactSystem &sys, const fibre::Vector &warm,
-                          const fibre::StepOptions &opt);
+                          const fibre::StepOptions &opt, fibre::SweepCache *cache);
   void check_step(const fibre::Substeps &steps, int substeps, const fibre::SpookParams &params,
                   std::vector<fibre::Body> bodies, std::vector<fibre::Contact> contacts,
                   fibre::Vector warm);

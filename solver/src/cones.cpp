@@ -11,10 +11,9 @@ Cones::Cones(const ContactSystem &sys)
     : rows_(sys.rows()), coeff_(std::size_t(sys.num_contacts()) * 3, 0.0)
 {
   for (int c = 0; c < sys.num_contacts(); ++c) {
-    const Contact &contact = sys.contacts()[c];
-    const double r_eff = effective_radius(sys.bodies(), contact);
+    const FrictionParams &f = sys.contacts()[c].friction;
     for (int k = 0; k < num_cones(rows_); ++k)
-      coeff_[3 * std::size_t(c) + k] = cone_coefficient(contact.friction, r_eff, k);
+      coeff_[3 * std::size_t(c) + k] = cone_coefficient(f, sys.effective_radius(c), k);
   }
 }
 

@@ -5,15 +5,6 @@
 
 namespace fibre {
 
-double effective_radius(const std::vector<Body> &bodies, const Contact &c)
-{
-  const double ra = bodies[c.a].radius;
-  // a wall's curvature radius R: > 0 convex, < 0 concave (LAMMPS's region contacts), 0 flat
-  const double R = c.wall_radius;
-  if (c.is_wall()) return R > 0 || R < -ra ? effective_radius(ra, &R) : ra;
-  return effective_radius(ra, &bodies[c.b].radius);
-}
-
 double cone_coefficient(const FrictionParams &f, double r_eff, int cone)
 {
   if (cone == 0) return f.mu;

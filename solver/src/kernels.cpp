@@ -235,26 +235,15 @@ Mat6 diagonal_block(const ContactSystem &sys, int c)
 
 Vec6 diagonal_entries(const ContactSystem &sys, int c, double split_a, double split_b)
 {
-  const Contact &k = sys.contacts()[c];
-  const ContactKinematics &q = sys.kinematics(c);
   const int rows = sys.rows();
   double wt[kMaxRows];
   row_weights(sys, c, wt);
+  const std::array<Vec6, 2> &sides = sys.diagonal_sides(c);
   Vec6 d = Vec6::Ones();
-  for (int r = 0; r < rows; ++r) d[r] = sys.sigma()[Eigen::Index(rows) * c + r];
-  for (int side = 0; side < (k.is_wall() ? 1 : 2); ++side) {
-    const double *m = sys.inv_mass().data() + 6 * std::size_t(side == 0 ? k.a : k.b);
-    const double split = side == 0 ? split_a : split_b;
-    const Vec3 &lever = side == 0 ? q.ra : q.rb;
-    for (int i = 0; i < 3; ++i) {
-      const Vec3 n = q.frame.row(i).transpose(), t = lever.cross(n);
-      const double rot = n[0] * n[0] * m[3] + n[1] * n[1] * m[4] + n[2] * n[2] * m[5];
-      d[i] += split * wt[i] *
-              (n[0] * n[0] * m[0] + n[1] * n[1] * m[1] + n[2] * n[2] * m[2] + t[0] * t[0] * m[3] +
-               t[1] * t[1] * m[4] + t[2] * t[2] * m[5]);
-      if (i + 3 < rows) d[i + 3] += split * wt[i + 3] * rot;
-    }
-  }
+  for (int r = 0; r < rows; ++r)
+    d[r] = sys.sigma()[Eigen::Index(rows) * c + r] + split_a * wt[r] * sides[0][r];
+  if (sys.body_pairs()[2 * std::size_t(c) + 1] >= 0) // a pair, not a wall
+    for (int r = 0; r < rows; ++r) d[r] += split_b * wt[r] * sides[1][r];
   return d;
 }
 

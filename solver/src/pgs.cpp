@@ -458,15 +458,32 @@ PgsResult pgs(const ContactSystem &sys, const Exchange &ex, const Cones &cones, 
   }
   // Four contacts at a time where the processor can (sweep_groups.hpp): the full sweeps, or
   // each colour phase; not the focused sweeps' lists
-  std::vector<std::unique_ptr<GroupedSweep>> grouped;
+  // (kept in control.cache while the kinematics hold: the same contacts, phases and masses)
+  std::vector<std::unique_ptr<GroupedSweep>> own;
+  std::vector<std::unique_ptr<GroupedSweep>> &grouped =
+      control.cache ? control.cache->grouped : own;
   if (control.grouped && !focus && grouped_sweeps_available()) {
-    if (coloured)
-      for (const std::vector<int> &phase : phases)
-        grouped.push_back(std::make_unique<GroupedSweep>(sys, cones, b, inv_mass, inv_scale,
-                                                         ex.local_owners(), &phase));
-    else
-      grouped.push_back(
-          std::make_unique<GroupedSweep>(sys, cones, b, inv_mass, inv_scale, ex.local_owners()));
+    const std::size_t wanted = coloured ? phases.size() : 1;
+    const bool kept = control.cache && control.cache->kinematics == sys.kinematics_id() &&
+                      grouped.size() == wanted && sys.row_mask().empty();
+    if (kept) {
+      for (const std::unique_ptr<GroupedSweep> &group : grouped)
+        group->refresh(sys, cones, b, inv_scale);
+    } else {
+      grouped.clear();
+      if (coloured)
+        for (const std::vector<int> &phase : phases)
+          grouped.push_back(std::make_unique<GroupedSweep>(sys, cones, b, inv_mass, inv_scale,
+                                                           ex.local_owners(), &phase));
+      else
+        grouped.push_back(
+            std::make_unique<GroupedSweep>(sys, cones, b, inv_mass, inv_scale, ex.local_owners()));
+      if (control.cache)
+        control.cache->kinematics = sys.row_mask().empty() ? sys.kinematics_id() : 0;
+    }
+  } else {
+    grouped.clear();
+    if (control.cache) control.cache->kinematics = 0;
   }
   Anderson anderson(std::max(control.anderson, 1), ex);
   const int period = std::max(control.anderson_period, 1);

@@ -42,7 +42,10 @@ Vector spook_rhs(const ContactSystem &sys, const Vector *extra_dv)
   Vector Gv;
   for (const Contact &k : sys.contacts())
     if (k.restitution > 0 || k.own_damping() || k.wall_moves() || k.implicit_normal) {
-      g_apply(sys, v, Gv);
+      if (sys.row_mask().empty() && sys.velocity_rows().size() == sys.contact_dofs())
+        Gv = sys.velocity_rows();
+      else
+        g_apply(sys, v, Gv);
       break;
     }
   const int rows = sys.rows();
@@ -117,20 +120,22 @@ Vector velocities_after_change(const ContactSystem &sys, const Exchange &ex, Vec
   return v_plus;
 }
 
-ContactWork contact_work(const ContactSystem &sys, const Vector &v_plus, const Vector &lambda)
+ContactWork contact_work(const ContactSystem &sys, const Vector &Gv_plus, const Vector &lambda)
 {
-  const Vector v_mid = 0.5 * (body_velocities(sys) + v_plus);
   ContactWork work;
   if (lambda.size() != sys.contact_dofs()) return work;
-  Vector Gv;
-  g_apply(sys, v_mid, Gv);
+  Vector Gv = sys.velocity_rows();
+  if (Gv.size() != sys.contact_dofs()) g_apply(sys, body_velocities(sys), Gv);
   const int rows = sys.rows();
+  const std::array<double, kMaxRows> at_rest{};
   for (int c = 0; c < sys.num_contacts(); ++c) {
-    const std::array<double, kMaxRows> wall = wall_rows(sys.contacts()[c]);
+    const std::array<double, kMaxRows> wall =
+        sys.walls_move() ? wall_rows(sys.contacts()[c]) : at_rest;
     for (int r = 0; r < rows; ++r) {
-      const double l = lambda[Eigen::Index(rows) * c + r];
+      const Eigen::Index row = Eigen::Index(rows) * c + r;
+      const double l = lambda[row];
       work.wall_work += l * wall[r];
-      work.dissipation -= l * (Gv[Eigen::Index(rows) * c + r] - wall[r]);
+      work.dissipation -= l * (0.5 * (Gv[row] + Gv_plus[row]) - wall[r]);
     }
   }
   return work;
@@ -146,7 +151,6 @@ std::vector<std::array<double, kMaxRows>> advance_springs(const ContactSystem &s
   Vector own, Gv0; // Gv0: G v at the step's start, for the springs with a damper of their own
   if (!Gv_plus) g_apply(sys, v_plus, own);
   const Vector &Gv = Gv_plus ? *Gv_plus : own;
-  const Cones cones(sys);
   const double h = sys.params().h;
   for (int c = 0; c < nc; ++c) {
     const Contact &k = sys.contacts()[c];
@@ -171,7 +175,8 @@ std::vector<std::array<double, kMaxRows>> advance_springs(const ContactSystem &s
       // (Tested on the spring alone, that spring was put back at the cone every step and drove
       // a sphere back up an obstacle; doc/design.md, session 18.)
       const double eps = k.compliance[rows_of.first];
-      const double limit = eps * cones.coeff(c, cone) * lambda_n / h;
+      const double coeff = cone_coefficient(k.friction, sys.effective_radius(c), cone);
+      const double limit = eps * coeff * lambda_n / h;
       const double tau = k.damper_time[rows_of.first];
       // (a load inside the cone by a margin far above round-off spares the square root)
       const Eigen::Vector2d load = xi + tau * w;
@@ -189,6 +194,7 @@ std::vector<std::array<double, kMaxRows>> advance_springs(const ContactSystem &s
         // the spring keeps that last share back, or a rolling sphere falls short of the cone's
         // torque (by 13% at the decks' step).
         if (ln > 0 && tau > 0) {
+          if (Gv0.size() == 0 && sys.row_mask().empty()) Gv0 = sys.velocity_rows();
           if (Gv0.size() == 0) g_apply(sys, body_velocities(sys), Gv0);
           Eigen::Vector2d w0 = Eigen::Vector2d::Zero();
           for (int i = 0; i < rows_of.size; ++i)

@@ -49,9 +49,10 @@ struct ContactState {
 // The active-set loop of doc/design.md section 2 around one linear solver, then the sweeps.
 class StepSolver {
  public:
-  StepSolver(ContactSystem &sys, const Exchange &ex, const StepOptions &opt, MPI_Comm comm)
-      : sys_(sys), ex_(ex), opt_(opt), comm_(comm), rows_(sys.rows()), nc_(sys.num_contacts()),
-        cones_(sys), state_(nc_), all_rows_(sys.contact_dofs(), 1)
+  StepSolver(ContactSystem &sys, const Exchange &ex, const StepOptions &opt, MPI_Comm comm,
+             SweepCache *cache)
+      : sys_(sys), ex_(ex), opt_(opt), comm_(comm), cache_(cache), rows_(sys.rows()),
+        nc_(sys.num_contacts()), cones_(sys), state_(nc_), all_rows_(sys.contact_dofs(), 1)
   {
   }
 
@@ -81,6 +82,7 @@ class StepSolver {
   const Exchange &ex_;
   const StepOptions &opt_;
   MPI_Comm comm_;
+  SweepCache *cache_;
   const int rows_, nc_;
   const Cones cones_;
   std::vector<ContactState> state_;
@@ -304,6 +306,7 @@ void StepSolver::finish(Vector &lambda, StepResult &res) const
     control.nonlinear_cg = opt_.sweep_cg || opt_.solver == Method::nncg;
     control.fibre_blocks = opt_.sweep_blocks || opt_.solver == Method::fbgs;
     control.block_weight = opt_.precond.weight;
+    control.cache = cache_;
     // the residual decides the rescue and the restart, except under the accuracy rule with a
     // sweeps-only solver
     const bool measured = opt_.residual || !accuracy || !sweeps_only();
@@ -482,9 +485,9 @@ StepResult StepSolver::run(const Vector *warm)
 } // namespace
 
 StepResult solve_step(ContactSystem &sys, const Exchange &ex, const StepOptions &opt,
-                      const Vector *warm, MPI_Comm comm)
+                      const Vector *warm, MPI_Comm comm, SweepCache *cache)
 {
-  StepSolver solver(sys, ex, opt, comm);
+  StepSolver solver(sys, ex, opt, comm, cache);
   return solver.run(warm);
 }
 

@@ -54,28 +54,33 @@ Substeps run_substeps(int n, const ContactModel &model, const SpookParams &param
   apply_contact_model(model, params, m_min, bodies, contacts, &warm);
   out.system = ContactSystem(std::move(bodies), std::move(contacts), rows, params, num_owned);
   ContactSystem &sys = out.system;
+  SweepCache cache;
+  const bool walls_move = sys.walls_move();
+  Vector Gv_plus; // G v+ of the last substep
   for (int sub = 1; sub <= n; ++sub) {
     const bool last = sub == n;
     if (sub > 1) { // the last substep's motion and springs, then the model at its impulses
-      Vector Gv;
-      g_apply(sys, out.v_plus, Gv);
       std::vector<std::array<double, kMaxRows>> springs;
-      if (model.compliance.material) springs = advance_springs(sys, out.v_plus, warm, &Gv);
+      if (model.compliance.material) springs = advance_springs(sys, out.v_plus, warm, &Gv_plus);
       const Vector &v_plus = out.v_plus;
-      sys.next_substep([&](std::vector<Body> &b, std::vector<Contact> &c) {
-        for (std::size_t k = 0; k < c.size(); ++k) {
-          c[k].gap += h * (Gv[Eigen::Index(rows) * Eigen::Index(k)] - wall_rows(c[k])[0]);
-          if (!springs.empty()) c[k].spring = springs[k];
-        }
-        for (std::size_t i = 0; i < b.size(); ++i) {
-          b[i].v = v_plus.segment<3>(6 * Eigen::Index(i));
-          b[i].omega = v_plus.segment<3>(6 * Eigen::Index(i) + 3);
-        }
-        apply_contact_model(model, params, m_min, b, c, &warm);
-      });
+      const Vector &Gv = Gv_plus;
+      sys.next_substep(
+          [&](std::vector<Body> &b, std::vector<Contact> &c) {
+            for (std::size_t k = 0; k < c.size(); ++k) {
+              const double wall = walls_move ? wall_rows(c[k])[0] : 0.0;
+              c[k].gap += h * (Gv[Eigen::Index(rows) * Eigen::Index(k)] - wall);
+              if (!springs.empty()) c[k].spring = springs[k];
+            }
+            for (std::size_t i = 0; i < b.size(); ++i) {
+              b[i].v = v_plus.segment<3>(6 * Eigen::Index(i));
+              b[i].omega = v_plus.segment<3>(6 * Eigen::Index(i) + 3);
+            }
+            apply_contact_model(model, params, m_min, b, c, &warm);
+          },
+          std::move(Gv_plus));
     }
     out.warm = warm;
-    StepResult res = solve(sys, warm, last);
+    StepResult res = solve(sys, warm, last, cache);
     const bool solved = res.dv.size() == sys.body_dofs();
     if (out.done == 0)
       out.totals = res;
@@ -86,8 +91,11 @@ Substeps run_substeps(int n, const ContactModel &model, const SpookParams &param
     if (!solved) break;
     const StepResult &r = out.result;
     out.v_plus = velocities_after_change(sys, ex, r.dv);
-    if (last && model.compliance.material) out.springs = advance_springs(sys, out.v_plus, r.lambda);
-    const ContactWork work = contact_work(sys, out.v_plus, r.lambda);
+    Gv_plus.resize(0);
+    g_apply(sys, out.v_plus, Gv_plus);
+    if (last && model.compliance.material)
+      out.springs = advance_springs(sys, out.v_plus, r.lambda, &Gv_plus);
+    const ContactWork work = contact_work(sys, Gv_plus, r.lambda);
     out.work.wall_work += work.wall_work;
     out.work.dissipation += work.dissipation;
     if (out.done == 1) {

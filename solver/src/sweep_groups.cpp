@@ -107,8 +107,6 @@ GroupedSweep::GroupedSweep(const ContactSystem &sys, const Cones &cones, const V
   pack_.assign(grouped.groups.size() * kFields * kGroupLanes, 0.0);
   const int *pairs = sys.body_pairs();
   const auto owner = [&](int body) { return owner_of(owners, body); };
-  const double *sigma = sys.sigma().data();
-  const std::size_t R = std::size_t(rows_);
   for (std::size_t lane = 0; lane < lanes; ++lane) {
     const int c = grouped.groups[lane / kGroupLanes][lane % kGroupLanes];
     if (c < 0) continue;
@@ -120,14 +118,28 @@ GroupedSweep::GroupedSweep(const ContactSystem &sys, const Cones &cones, const V
     const auto put = [p](int field, double value) { p[kGroupLanes * field] = value; };
     const double *q = sys.kinematics(c).frame.data();
     for (int f = 0; f < 15; ++f) put(kFrame + f, q[f]);
+    for (int d = 0; d < 6; ++d) {
+      put(kMassA + d, inv_mass[6 * std::size_t(a) + d]);
+      put(kMassB + d, bb >= 0 ? inv_mass[6 * std::size_t(bb) + d] : 0.0);
+    }
+  }
+  refresh(sys, cones, b, inv_scale);
+}
+
+void GroupedSweep::refresh(const ContactSystem &sys, const Cones &cones, const Vector &b,
+                           const std::vector<Vec6> &inv_scale)
+{
+  const double *sigma = sys.sigma().data();
+  const std::size_t R = std::size_t(rows_);
+  for (std::size_t lane = 0; lane < contact_.size(); ++lane) {
+    const int c = contact_[lane];
+    if (c < 0) continue;
+    double *p = pack_.data() + (lane / kGroupLanes) * kFields * kGroupLanes + lane % kGroupLanes;
+    const auto put = [p](int field, double value) { p[kGroupLanes * field] = value; };
     for (std::size_t i = 0; i < R; ++i) {
       put(kRhs + int(i), b[Eigen::Index(R * c + i)]);
       put(kSigma + int(i), sigma[R * c + i]);
       put(kScale + int(i), inv_scale[c][Eigen::Index(i)]);
-    }
-    for (int d = 0; d < 6; ++d) {
-      put(kMassA + d, inv_mass[6 * std::size_t(a) + d]);
-      put(kMassB + d, bb >= 0 ? inv_mass[6 * std::size_t(bb) + d] : 0.0);
     }
     for (int k = 0; k < num_cones(rows_); ++k) put(kCoeff + k, cones.coeff(c, k));
   }

@@ -1,6 +1,7 @@
 #include "fibre/system.hpp"
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <stdexcept>
 #include <string>
@@ -57,6 +58,15 @@ Contact sphere_wall_contact(const std::vector<Body> &bodies, int a, const Vec3 &
   c.gap = distance - A.radius;
   c.point = A.x - c.normal * (A.radius + 0.5 * c.gap);
   return c;
+}
+
+double effective_radius(const std::vector<Body> &bodies, const Contact &c)
+{
+  const double ra = bodies[c.a].radius;
+  // a wall's curvature radius R: > 0 convex, < 0 concave (LAMMPS's region contacts), 0 flat
+  const double R = c.wall_radius;
+  if (c.is_wall()) return R > 0 || R < -ra ? effective_radius(ra, &R) : ra;
+  return effective_radius(ra, &bodies[c.b].radius);
 }
 
 std::array<double, kMaxRows> wall_rows(const Contact &c)
@@ -119,6 +129,30 @@ void ContactSystem::compute_derived()
     q.frame.row(2) = k.t2.transpose();
     q.ra = k.point - bodies_[k.a].x;
     q.rb = k.is_wall() ? Vec3::Zero() : Vec3(k.point - bodies_[k.b].x);
+  }
+  static std::atomic<std::uint64_t> next_id{0};
+  kinematics_id_ = ++next_id;
+  sides_.resize(nc);
+  r_eff_.resize(nc);
+  walls_move_ = false;
+  for (int c = 0; c < nc; ++c) {
+    const Contact &k = contacts_[c];
+    const ContactKinematics &q = kin_[c];
+    walls_move_ = walls_move_ || k.wall_moves();
+    for (int side = 0; side < 2; ++side) {
+      Vec6 &d = sides_[c][side];
+      d.setZero();
+      if (side == 1 && k.is_wall()) continue;
+      const double *m = inv_mass_.data() + 6 * std::size_t(side == 0 ? k.a : k.b);
+      const Vec3 &lever = side == 0 ? q.ra : q.rb;
+      for (int i = 0; i < 3; ++i) {
+        const Vec3 n = q.frame.row(i).transpose(), t = lever.cross(n);
+        d[i] = n[0] * n[0] * m[0] + n[1] * n[1] * m[1] + n[2] * n[2] * m[2] + t[0] * t[0] * m[3] +
+               t[1] * t[1] * m[4] + t[2] * t[2] * m[5];
+        d[i + 3] = n[0] * n[0] * m[3] + n[1] * n[1] * m[4] + n[2] * n[2] * m[5];
+      }
+    }
+    r_eff_[c] = fibre::effective_radius(bodies_, k);
   }
   compute_rows();
 }

@@ -11,6 +11,7 @@
 #include <utility>
 
 #include "fibre/apgd.hpp"
+#include "fibre/kernels.hpp"
 #include "fibre/nonsmooth_reference.hpp"
 #include "fibre/pgs.hpp"
 #include "fibre/scenes.hpp"
@@ -658,4 +659,54 @@ TEST(SweepGroups, AreGaussSeidelInTheGroupsOrder)
     EXPECT_LT(step_accuracy(base.sys, converged, ref.lambda).velocity(), 1e-7);
     EXPECT_LT(step_accuracy(base.sys, converged, ref.lambda).lambda_n, 1e-7);
   }
+}
+
+// The groups kept for the next substep (SweepCache) sweep as groups built anew: after the
+// substep's new velocities, compliances, friction and rhs the kept solve is the fresh one bit
+// for bit, and a system of other kinematics gets its own groups.
+TEST(SweepGroups, KeptForTheNextSubstepSweepAsBuiltAnew)
+{
+  if (!grouped_sweeps_available()) GTEST_SKIP() << "no AVX2 and FMA on this processor";
+  Problem pr = pile(200, 0.4);
+  pr.sys.set_friction(FrictionParams{0.4, 0.05, 0.02});
+  const auto solve = [](const ContactSystem &sys, SweepCache *cache) {
+    PgsControl control{30, 0.0, 30};
+    control.cache = cache;
+    Vector lambda = Vector::Zero(sys.contact_dofs());
+    pgs(sys, serial_exchange(), Cones(sys), spook_rhs(sys), row_scales(sys), lambda, control);
+    return lambda;
+  };
+  SweepCache cache;
+  const Vector first = solve(pr.sys, &cache);
+  EXPECT_EQ(cache.kinematics, pr.sys.kinematics_id());
+  ASSERT_EQ(cache.grouped.size(), 1u);
+  const GroupedSweep *kept = cache.grouped[0].get();
+
+  // the next substep: the bodies at the velocities the impulses give, softer rows, more friction
+  const Vector v_plus = velocities_after(pr.sys, serial_exchange(), first);
+  Vector rows;
+  g_apply(pr.sys, v_plus, rows);
+  const std::uint64_t id = pr.sys.kinematics_id();
+  pr.sys.next_substep(
+      [&](std::vector<Body> &bodies, std::vector<Contact> &contacts) {
+        for (std::size_t i = 0; i < bodies.size(); ++i) {
+          bodies[i].v = v_plus.segment<3>(6 * Eigen::Index(i));
+          bodies[i].omega = v_plus.segment<3>(6 * Eigen::Index(i) + 3);
+        }
+        for (Contact &c : contacts) {
+          for (double &eps : c.compliance) eps *= 3.0;
+          c.friction.mu = 0.6;
+        }
+      },
+      std::move(rows));
+  ASSERT_EQ(pr.sys.kinematics_id(), id); // the kinematics hold
+  const Vector again = solve(pr.sys, &cache);
+  EXPECT_EQ(cache.grouped[0].get(), kept); // refreshed, not rebuilt
+  const Vector fresh = solve(pr.sys, nullptr);
+  EXPECT_GT(rel_diff(again, first), 1e-3); // the substep changed the solve
+  EXPECT_EQ(again, fresh);
+
+  const Problem other = pile(120, 0.4);
+  EXPECT_EQ(solve(other.sys, &cache), solve(other.sys, nullptr));
+  EXPECT_EQ(cache.kinematics, other.sys.kinematics_id());
 }

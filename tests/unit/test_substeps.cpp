@@ -44,12 +44,18 @@ ContactModel compliant_model(double eps)
   return model;
 }
 
-StepResult solve(ContactSystem &sys, const Vector &warm, bool = true)
+StepResult solve(ContactSystem &sys, const Vector &warm, SweepCache *cache = nullptr)
 {
   StepOptions opt; // the fix's defaults, solved tighter than they stop
   opt.stop.tol = 1e-12;
   opt.accuracy = 1e-12;
-  return solve_step(sys, serial_exchange(), opt, &warm, MPI_COMM_SELF);
+  return solve_step(sys, serial_exchange(), opt, &warm, MPI_COMM_SELF, cache);
+}
+
+// The same as run_substeps's solve, the sweeps' groups kept from substep to substep.
+StepResult substep_solve(ContactSystem &sys, const Vector &warm, bool, SweepCache &cache)
+{
+  return solve(sys, warm, &cache);
 }
 
 // One step as the fix did it before substeps: the model, the system, the solve; returns v+.
@@ -91,7 +97,7 @@ TEST(Substeps, AreStepsOfTheirLengthWhereTheGeometryHolds)
   std::vector<Body> bodies = start;
   std::vector<Contact> contacts{sphere_sphere_contact(bodies, 1, 0)};
   const Substeps steps = run_substeps(n, model, params, 1.0, serial_exchange(), 2, bodies, contacts,
-                                      Vector::Zero(3), solve);
+                                      Vector::Zero(3), substep_solve);
   ASSERT_EQ(steps.done, n);
   const Vector &v_final = steps.v_plus, &impulse = steps.lambda, &path = steps.path;
 
@@ -140,8 +146,8 @@ TEST(Substeps, CarryARestingSpheresWeightOverTheStep)
   // the warm start of a sphere that has rested there: its weight over a substep
   Vector warm = Vector::Zero(3);
   warm[0] = g * bodies[0].mass * params.h;
-  const Substeps steps =
-      run_substeps(n, model, params, 1.0, serial_exchange(), 1, bodies, contacts, warm, solve);
+  const Substeps steps = run_substeps(n, model, params, 1.0, serial_exchange(), 1, bodies, contacts,
+                                      warm, substep_solve);
   ASSERT_EQ(steps.done, n);
   const double weight_impulse = g * 2.0 * h;
   EXPECT_NEAR(steps.lambda[0], weight_impulse, 1e-8 * weight_impulse);
@@ -166,23 +172,23 @@ TEST(Substeps, OneIsThePlainStepAndOnlyTheLastMeasuresItsResidual)
   Vector lambda;
   const Vector v_plus = one_step(model, params, bodies, contacts, Vector::Zero(3), lambda);
   const Substeps one = run_substeps(1, model, params, 1.0, serial_exchange(), 2, bodies, contacts,
-                                    Vector::Zero(3), solve);
+                                    Vector::Zero(3), substep_solve);
   ASSERT_EQ(one.done, 1);
   EXPECT_EQ(one.lambda, lambda);
   EXPECT_EQ(one.v_plus, v_plus);
   EXPECT_EQ(one.result.lambda, lambda);
 
-  const auto skipping = [](ContactSystem &sys, const Vector &warm, bool last) {
+  const auto skipping = [](ContactSystem &sys, const Vector &warm, bool last, SweepCache &cache) {
     StepOptions opt;
     opt.residual = last;
-    return solve_step(sys, serial_exchange(), opt, &warm, MPI_COMM_SELF);
+    return solve_step(sys, serial_exchange(), opt, &warm, MPI_COMM_SELF, &cache);
   };
   params.h = h / 4;
   std::vector<double> residuals;
   const Substeps four =
       run_substeps(4, model, params, 1.0, serial_exchange(), 2, bodies, contacts, Vector::Zero(3),
-                   [&](ContactSystem &sys, const Vector &warm, bool last) {
-                     const StepResult r = skipping(sys, warm, last);
+                   [&](ContactSystem &sys, const Vector &warm, bool last, SweepCache &cache) {
+                     const StepResult r = skipping(sys, warm, last, cache);
                      residuals.push_back(r.complementarity);
                      return r;
                    });

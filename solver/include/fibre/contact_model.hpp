@@ -85,13 +85,6 @@ struct ContactModel {
 // the maximum over processes).
 double external_speed_per_step(const std::vector<Body> &bodies, int num_owned, double h);
 
-// r_eff = ra rb / (ra + rb) for a pair, ra against a wall (b == nullptr).
-inline double effective_radius(double ra, const double *rb)
-{
-  return rb ? ra * *rb / (ra + *rb) : ra;
-}
-double effective_radius(const std::vector<Body> &bodies, const Contact &c);
-
 // Cone radius per unit normal impulse of cone k (0 Coulomb, 1 twisting, 2 rolling).
 double cone_coefficient(const FrictionParams &f, double r_eff, int cone);
 

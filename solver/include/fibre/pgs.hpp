@@ -12,6 +12,7 @@
 #include "fibre/exchange.hpp"
 #include "fibre/fibres.hpp"
 #include "fibre/solver_control.hpp"
+#include "fibre/sweep_groups.hpp"
 
 namespace fibre {
 
@@ -55,6 +56,9 @@ struct PgsControl {
   // The error-estimate rule stops no sooner than this: a rule met before stops the sweeps
   // here (and a full sweep that changes nothing, or only by round-off, at once).
   int min_sweeps = 0;
+  // The groups of the sweeps kept from one solve of a system's kinematics to the next (the
+  // substeps of a step) and rebuilt for other kinematics; null: built for this solve alone.
+  SweepCache *cache = nullptr;
 };
 
 inline constexpr int kRateWindow = 5;

@@ -37,12 +37,12 @@ Vector velocities_after_change(const ContactSystem &sys, const Exchange &ex, Vec
 // the wall's velocity; `dissipation` is lambda . the relative velocity at the step's mean
 // velocity (v + v+) / 2, with a minus sign: the energy the contacts take out (dissipated, or
 // stored in compliant rows). Their kinetic energy change is wall_work - dissipation, exactly,
-// since the impulses change v linearly. v_plus: velocities_after(sys, ex, lambda).
+// since the impulses change v linearly. Gv_plus: G v+, v+ = velocities_after(sys, ex, lambda).
 struct ContactWork {
   double wall_work = 0.0;
   double dissipation = 0.0;
 };
-ContactWork contact_work(const ContactSystem &sys, const Vector &v_plus, const Vector &lambda);
+ContactWork contact_work(const ContactSystem &sys, const Vector &Gv_plus, const Vector &lambda);
 
 // The elastic rows' displacements at the step's end, rows per contact in each contact's frame
 // (Contact::spring): spring + h G v+ on every elastic row, with v+ = v + h M^-1 f + M^-1 G^T

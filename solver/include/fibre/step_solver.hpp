@@ -159,7 +159,8 @@ struct StepResult {
 // feasible (lambda_n >= 0, every cone), and projected Gauss-Seidel sweeps follow while the
 // complementarity residual exceeds sweep_tol: in piles the set rarely settles, and the sweeps
 // are what makes the step's friction hold (StepResult::complementarity).
+// `cache`: the sweeps' groups kept between the solves of one system's substeps (SweepCache).
 StepResult solve_step(ContactSystem &sys, const Exchange &ex, const StepOptions &opt,
-                      const Vector *warm, MPI_Comm comm);
+                      const Vector *warm, MPI_Comm comm, SweepCache *cache = nullptr);
 
 } // namespace fibre

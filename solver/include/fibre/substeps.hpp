@@ -42,8 +42,10 @@ struct Substeps {
 };
 
 // The solve of one substep's system from a warm start (a front end's: collective, it reports
-// failures); `last`: the step's last substep. A result without dv ends the substeps.
-using SubstepSolve = std::function<StepResult(ContactSystem &, const Vector &warm, bool last)>;
+// failures); `last`: the step's last substep; `cache`: the sweeps' groups, kept from substep to
+// substep (solve_step). A result without dv ends the substeps.
+using SubstepSolve =
+    std::function<StepResult(ContactSystem &, const Vector &warm, bool last, SweepCache &cache)>;
 
 // Runs the n substeps of length params.h (h / n) on one system built from `bodies` and
 // `contacts`: each applies the contact model (compliances and restitution from the last

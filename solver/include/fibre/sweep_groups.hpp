@@ -7,6 +7,8 @@
 #pragma once
 
 #include <array>
+#include <cstdint>
+#include <memory>
 #include <vector>
 
 #include "fibre/cones.hpp"
@@ -44,6 +46,10 @@ class GroupedSweep {
   GroupedSweep(const ContactSystem &sys, const Cones &cones, const Vector &b,
                const double *inv_mass, const std::vector<Vec6> &inv_scale,
                const std::vector<int> &owners, const std::vector<int> *list = nullptr);
+  // The same groups for a system of the same kinematics (ContactSystem::kinematics_id) and
+  // masses: its rhs, Sigma, row scales and cones' coefficients (the next substep's).
+  void refresh(const ContactSystem &sys, const Cones &cones, const Vector &b,
+               const std::vector<Vec6> &inv_scale);
   // One sweep over the groups, as pgs.cpp's sweep over the same contacts one at a time:
   // lambda and dv updated, ||change||^2 and ||lambda||^2 added to norms. The singles are not
   // swept here.
@@ -55,6 +61,13 @@ class GroupedSweep {
   std::vector<double> pack_;                   // kFields x kGroupLanes per group
   std::vector<int> contact_, body_a_, body_b_; // per lane; -1: empty lane, wall
   std::vector<int> singles_;
+};
+
+// The sweeps' groups that the solves of one system share while its kinematics hold (the
+// substeps of a step: ContactSystem::next_substep): built by the first, refreshed by the next.
+struct SweepCache {
+  std::uint64_t kinematics = 0; // ContactSystem::kinematics_id of the groups; 0: none
+  std::vector<std::unique_ptr<GroupedSweep>> grouped;
 };
 
 } // namespace fibre

@@ -7,6 +7,7 @@
 
 #include <Eigen/Dense>
 #include <array>
+#include <cstdint>
 #include <vector>
 
 namespace fibre {
@@ -117,6 +118,14 @@ struct Contact {
 // contributes with a minus sign. Zero for a pair or a wall at rest.
 std::array<double, kMaxRows> wall_rows(const Contact &c);
 
+// r_eff = ra rb / (ra + rb) for a pair, ra against a wall (b == nullptr).
+inline double effective_radius(double ra, const double *rb)
+{
+  return rb ? ra * *rb / (ra + *rb) : ra;
+}
+// A contact's: its wall's curvature radius (Contact::wall_radius) counts as rb where it has one.
+double effective_radius(const std::vector<Body> &bodies, const Contact &c);
+
 // A deterministic orthonormal completion (t1, t2) of the unit vector n.
 void tangent_frame(const Vec3 &n, Vec3 &t1, Vec3 &t2);
 
@@ -201,6 +210,18 @@ class ContactSystem {
   const std::vector<Body> &bodies() const { return bodies_; }
   const std::vector<Contact> &contacts() const { return contacts_; }
   const ContactKinematics &kinematics(int c) const { return kin_[c]; }
+  // Names the kinematics: every system built gets its own; next_substep keeps it (and a copy
+  // shares it). What the solves derive from the kinematics alone may be kept under it
+  // (SweepCache).
+  std::uint64_t kinematics_id() const { return kinematics_id_; }
+  // Contact c's side a and side b of the diagonal of G M^-1 G^T, every row active (their sum
+  // and Sigma are A_ii: diagonal_entries), and its effective radius (fibre::effective_radius).
+  // Derived once per system: the substeps of a step share them.
+  const std::array<Vec6, 2> &diagonal_sides(int c) const { return sides_[c]; }
+  double effective_radius(int c) const { return r_eff_[c]; }
+  // Whether some contact's wall or obstacle moves (Contact::wall_moves): else every wall_rows
+  // is zero, and the passes that would read them skip the contacts.
+  bool walls_move() const { return walls_move_; }
   const Vector &inv_mass() const { return inv_mass_; } // diagonal of M^-1, 6 per body
   const Vector &mass() const { return mass_; }         // diagonal of M, 6 per body
   const Vector &sigma() const { return sigma_; }       // diagonal of Sigma, rows per contact
@@ -227,11 +248,17 @@ class ContactSystem {
   // contacts' gaps, springs, compliances and damping change; the bodies' positions and masses
   // and the contacts' bodies, frames and points do not, so the kinematics hold. `edit` changes
   // them; Sigma then follows the new compliances and damping.
-  template <typename Edit> void next_substep(Edit &&edit)
+  // velocity_rows: G times the new velocities, which the caller has (the last substep's G v+);
+  // taken over after the edit, which may read it.
+  template <typename Edit> void next_substep(Edit &&edit, Vector &&velocity_rows)
   {
     edit(bodies_, contacts_);
     compute_rows();
+    velocity_rows_ = std::move(velocity_rows);
   }
+  // G v of the bodies' velocities, every row active, where known (a substep after the first:
+  // next_substep), else empty.
+  const Vector &velocity_rows() const { return velocity_rows_; }
   bool row_active(Eigen::Index row) const { return mask_.empty() || mask_[row] != 0; }
 
  private:
@@ -244,6 +271,10 @@ class ContactSystem {
   std::vector<Body> bodies_;
   std::vector<Contact> contacts_;
   std::vector<ContactKinematics> kin_;
+  std::uint64_t kinematics_id_ = 0;
+  std::vector<std::array<Vec6, 2>> sides_;
+  std::vector<double> r_eff_;
+  bool walls_move_ = false;
   std::vector<unsigned char> mask_; // empty = all rows active
   Vector inv_mass_;
   Vector mass_;
@@ -252,6 +283,7 @@ class ContactSystem {
   Vector row_weight_;      // empty = all rows active
   std::vector<int> pairs_; // a, b per contact
   Vector rhs_;
+  Vector velocity_rows_;
 };
 
 } // namespace fibre
