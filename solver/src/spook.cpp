@@ -152,11 +152,12 @@ std::vector<std::array<double, kMaxRows>> advance_springs(const ContactSystem &s
   if (!Gv_plus) g_apply(sys, v_plus, own);
   const Vector &Gv = Gv_plus ? *Gv_plus : own;
   const double h = sys.params().h;
+  const std::array<double, kMaxRows> at_rest{};
   for (int c = 0; c < nc; ++c) {
     const Contact &k = sys.contacts()[c];
     if (!k.any_elastic()) continue;
     const Eigen::Index base = Eigen::Index(rows) * c;
-    const std::array<double, kMaxRows> wall = wall_rows(k);
+    const std::array<double, kMaxRows> wall = sys.walls_move() ? wall_rows(k) : at_rest;
     const double lambda_n = lambda.size() == sys.contact_dofs() ? std::max(lambda[base], 0.0) : 0.0;
     for (int cone = 0; cone < num_cones(rows); ++cone) {
       const Cone &rows_of = kCones[cone];

@@ -474,7 +474,7 @@ StepResult StepSolver::run(const Vector *warm)
     res.reason =
         res.sweep_reason == StopReason::converged ? StopReason::stagnation : res.sweep_reason;
   }
-  count_set(lambda, res);
+  if (opt_.residual) count_set(lambda, res);
   sys_.set_rhs(b_full_);
   res.dv = body_from_lambda(sys_, ex_, lambda);
   res.lambda = std::move(lambda);

@@ -87,9 +87,11 @@ struct StepOptions {
   // sweep_groups.hpp; where the processor has AVX2 and FMA): the same sweeps in another order,
   // at half the time a sweep (bench/README.md, "Sweeps four contacts at a time").
   bool sweep_groups = true;
-  // Whether the result measures its complementarity residual (StepResult::complementarity).
-  // Substeps before a step's last skip it where it decides nothing (the accuracy rule with a
-  // sweeps-only solver): it costs two products with G, and only the last one is reported.
+  // Whether the result reports its complementarity residual (StepResult::complementarity) and
+  // counts its released and capped rows. Without, it counts nothing and measures the residual
+  // only where the residual decides the solve (not under the accuracy rule with a sweeps-only
+  // solver). The substeps before a step's last go without: only the last one is reported, and
+  // the residual and the counts cost two products with G, a pass over the cones and a sum.
   bool residual = true;
 };
 
@@ -113,8 +115,9 @@ struct StepResult {
   bool converged = true;
   int active_set_passes = 0; // linear solves done (1 .. active_set_max)
   bool set_settled = false;  // the active set and its caps settled (see cap_tol)
-  int released = 0;          // contacts with zero impulse at the end (lambda_n < 0)
-  int capped = 0;            // friction/rolling/twisting rows on their cone boundary
+  // (both 0 when not counted: StepOptions::residual)
+  int released = 0; // contacts with zero impulse at the end (lambda_n < 0)
+  int capped = 0;   // friction/rolling/twisting rows on their cone boundary
   // Relative residual of the contact conditions at the final lambda (see complementarity()
   // in contact_solver.cpp): 0 for an exact solution of the nonsmooth step, -1 where it was not
   // measured (StepOptions::residual).
