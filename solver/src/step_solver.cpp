@@ -52,7 +52,8 @@ class StepSolver {
   StepSolver(ContactSystem &sys, const Exchange &ex, const StepOptions &opt, MPI_Comm comm,
              SweepCache *cache)
       : sys_(sys), ex_(ex), opt_(opt), comm_(comm), cache_(cache), rows_(sys.rows()),
-        nc_(sys.num_contacts()), cones_(sys), state_(nc_), all_rows_(sys.contact_dofs(), 1)
+        nc_(sys.num_contacts()), cones_(sys), state_(sweeps_only() ? 0 : nc_),
+        all_rows_(sys.contact_dofs(), 1)
   {
   }
 
@@ -85,7 +86,7 @@ class StepSolver {
   SweepCache *cache_;
   const int rows_, nc_;
   const Cones cones_;
-  std::vector<ContactState> state_;
+  std::vector<ContactState> state_; // the active-set loop's; none with the sweeps alone
   const std::vector<unsigned char> all_rows_;
   Vector b_full_;                // the rhs with every row active and no fixed impulses
   std::vector<Vec6> row_scales_; // the sweeps' and residuals' row scales, every row active
@@ -252,9 +253,10 @@ int StepSolver::update_set(const Vector &lambda, const std::vector<unsigned char
 // direction with the final normal impulse.
 void StepSolver::project(Vector &lambda) const
 {
+  const bool tracked = !state_.empty();
   for (int c = 0; c < nc_; ++c) {
     const double ln = lambda[base(c)];
-    if (state_[c].released || !(ln > 0)) {
+    if ((tracked && state_[c].released) || !(ln > 0)) {
       lambda.segment(base(c), rows_).setZero();
       continue;
     }
@@ -262,7 +264,7 @@ void StepSolver::project(Vector &lambda) const
       const Cone &cone = kCones[k];
       const double radius = coeff(c, k) * ln;
       Eigen::Vector2d t = cone_values(lambda, base(c), cone);
-      if (state_[c].capped[k]) {
+      if (tracked && state_[c].capped[k]) {
         t = radius * state_[c].dir[k];
       } else if (t.squaredNorm() <= (1 - 1e-12) * radius * radius || t.norm() <= radius) {
         continue; // inside (by a margin far above round-off: no square root; most cones stick)
