@@ -465,6 +465,7 @@ PgsResult pgs(const ContactSystem &sys, const Exchange &ex, const Cones &cones, 
   if (control.grouped && !focus && grouped_sweeps_available()) {
     const std::size_t wanted = coloured ? phases.size() : 1;
     const bool kept = control.cache && control.cache->kinematics == sys.kinematics_id() &&
+                      control.cache->split_masses == (split.size() > 0) &&
                       grouped.size() == wanted && sys.row_mask().empty();
     if (kept) {
       for (const std::unique_ptr<GroupedSweep> &group : grouped)
@@ -478,8 +479,10 @@ PgsResult pgs(const ContactSystem &sys, const Exchange &ex, const Cones &cones, 
       else
         grouped.push_back(
             std::make_unique<GroupedSweep>(sys, cones, b, inv_mass, inv_scale, ex.local_owners()));
-      if (control.cache)
+      if (control.cache) {
         control.cache->kinematics = sys.row_mask().empty() ? sys.kinematics_id() : 0;
+        control.cache->split_masses = split.size() > 0;
+      }
     }
   } else {
     grouped.clear();

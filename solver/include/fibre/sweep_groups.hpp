@@ -67,6 +67,7 @@ class GroupedSweep {
 // substeps of a step: ContactSystem::next_substep): built by the first, refreshed by the next.
 struct SweepCache {
   std::uint64_t kinematics = 0; // ContactSystem::kinematics_id of the groups; 0: none
+  bool split_masses = false;    // packed with split inverse masses (pgs.cpp, mass splitting)
   std::vector<std::unique_ptr<GroupedSweep>> grouped;
 };
 
