@@ -7,6 +7,21 @@
 
 namespace fibre {
 
+namespace {
+
+// G v of the bodies' velocities: the substep's, where next_substep gave it and no row is
+// masked (ContactSystem::velocity_rows), else the product.
+Vector start_rows(const ContactSystem &sys)
+{
+  if (sys.row_mask().empty() && sys.velocity_rows().size() == sys.contact_dofs())
+    return sys.velocity_rows();
+  Vector Gv;
+  g_apply(sys, body_velocities(sys), Gv);
+  return Gv;
+}
+
+} // namespace
+
 Vector body_velocities(const ContactSystem &sys)
 {
   Vector v(sys.body_dofs());
@@ -42,10 +57,7 @@ Vector spook_rhs(const ContactSystem &sys, const Vector *extra_dv)
   Vector Gv;
   for (const Contact &k : sys.contacts())
     if (k.restitution > 0 || k.own_damping() || k.wall_moves() || k.implicit_normal) {
-      if (sys.row_mask().empty() && sys.velocity_rows().size() == sys.contact_dofs())
-        Gv = sys.velocity_rows();
-      else
-        g_apply(sys, v, Gv);
+      Gv = start_rows(sys);
       break;
     }
   const int rows = sys.rows();
@@ -124,8 +136,7 @@ ContactWork contact_work(const ContactSystem &sys, const Vector &Gv_plus, const 
 {
   ContactWork work;
   if (lambda.size() != sys.contact_dofs()) return work;
-  Vector Gv = sys.velocity_rows();
-  if (Gv.size() != sys.contact_dofs()) g_apply(sys, body_velocities(sys), Gv);
+  const Vector Gv = start_rows(sys);
   const int rows = sys.rows();
   const std::array<double, kMaxRows> at_rest{};
   for (int c = 0; c < sys.num_contacts(); ++c) {
@@ -195,8 +206,7 @@ std::vector<std::array<double, kMaxRows>> advance_springs(const ContactSystem &s
         // the spring keeps that last share back, or a rolling sphere falls short of the cone's
         // torque (by 13% at the decks' step).
         if (ln > 0 && tau > 0) {
-          if (Gv0.size() == 0 && sys.row_mask().empty()) Gv0 = sys.velocity_rows();
-          if (Gv0.size() == 0) g_apply(sys, body_velocities(sys), Gv0);
+          if (Gv0.size() == 0) Gv0 = start_rows(sys);
           Eigen::Vector2d w0 = Eigen::Vector2d::Zero();
           for (int i = 0; i < rows_of.size; ++i)
             w0[i] = Gv0[base + rows_of.first + i] - wall[rows_of.first + i];

@@ -91,7 +91,6 @@ Substeps run_substeps(int n, const ContactModel &model, const SpookParams &param
     if (!solved) break;
     const StepResult &r = out.result;
     out.v_plus = velocities_after_change(sys, ex, r.dv);
-    Gv_plus.resize(0);
     g_apply(sys, out.v_plus, Gv_plus);
     if (last && model.compliance.material)
       out.springs = advance_springs(sys, out.v_plus, r.lambda, &Gv_plus);
