@@ -38,13 +38,14 @@ enum Stat {
   V_DISSIPATION,    // cumulative, likewise
   V_CHECK_VELOCITY, // the last check's errors against the converged step (keyword check)
   V_CHECK_IMPULSE,
+  V_SUBSTEPS, // the last step's contact solves (substeps; 1 where it had no collision)
   V_SIZE
 };
 
 class FibreOutput : protected LAMMPS_NS::Pointers {
  public:
   static constexpr int kLocalColumns = 8;
-  static constexpr double kRestartFormat = 5.0; // 5: 20 global values (4: 18, 3: 16, 2: 15)
+  static constexpr double kRestartFormat = 6.0; // 6: 21 global values (5: 20, 4: 18, 3: 16, 2: 15)
 
   explicit FibreOutput(LAMMPS_NS::LAMMPS *lmp) : Pointers(lmp)
   {
@@ -68,6 +69,7 @@ class FibreOutput : protected LAMMPS_NS::Pointers {
   // The solve's figures (summed or maximised over processes), with a warning at most every
   // 100 steps while solves fail. A step without contacts reports an empty, converged result.
   void report_solve(const fibre::StepResult &res);
+  void report_substeps(int done) { stats_[V_SUBSTEPS] = done; }
   // Adds one step's work of the contacts (this process's contacts; summed here).
   void add_work(const fibre::ContactWork &work);
   // A check's errors (keyword check), with a warning where its reference did not converge.

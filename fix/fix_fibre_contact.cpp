@@ -493,12 +493,33 @@ double FixFibreContact::bounce_speed(const std::vector<fibre::Body> &bodies, dou
 {
   const fibre::ContactModel &model = settings_.model;
   if (!model.may_bounce() || model.bounce_speed >= 0) return std::max(model.bounce_speed, 0.0);
-  double v = fibre::external_speed_per_step(bodies, exchange_->num_owned(), h);
-  MPI_Allreduce(MPI_IN_PLACE, &v, 1, MPI_DOUBLE, MPI_MAX, world);
+  const double v = impact_speed(bodies, h);
   // Without external forces every approach would bounce, the new contacts of a sheared pack
   // too (it threw grains out of the shear cell): then the automatic overlap recovery speed of
   // the step (of a substep it would keep a head-on pair at 1 m/s from bouncing at 16 substeps).
-  return v > 0 ? model.bounce_steps * v : model.recovery_radii * r_min_ / dtv_;
+  return v > 0 ? v : model.recovery_radii * r_min_ / dtv_;
+}
+
+// The speed above which a contact moves (step_moves) or bounces (bounce_speed): bounce_steps
+// times the largest speed the external forces add to a body in h (0 without external forces),
+// over every process.
+double FixFibreContact::impact_speed(const std::vector<fibre::Body> &bodies, double h) const
+{
+  double v = fibre::external_speed_per_step(bodies, exchange_->num_owned(), h);
+  MPI_Allreduce(MPI_IN_PLACE, &v, 1, MPI_DOUBLE, MPI_MAX, world);
+  return settings_.model.bounce_steps * v;
+}
+
+// Whether some contact of any process moves within the step (fibre::step_moves) at more than
+// the impact speed of a substep hs.
+bool FixFibreContact::step_moves(const std::vector<fibre::Body> &bodies,
+                                 const std::vector<fibre::Contact> &contacts, double hs) const
+{
+  const double speed = impact_speed(bodies, hs);
+  const fibre::SpookParams step{dtv_, settings_.model.damping};
+  int moves = fibre::step_moves(bodies, contacts, step, speed) ? 1 : 0;
+  MPI_Allreduce(MPI_IN_PLACE, &moves, 1, MPI_INT, MPI_MAX, world);
+  return moves != 0;
 }
 
 // With substeps the positions follow the substeps' velocities, x_{n+1} = x_n + hs sum_k v_k,
@@ -640,8 +661,8 @@ void FixFibreContact::final_integrate()
   // Detection reaches as far as impacts may kick the bodies where they bounce, and with
   // substeps also where they do not: a sphere that a plastic impact kicks in the step's first
   // substep moves on at its new speed in the others (without, a stiff pour blew up).
-  const int substeps = step_substeps();
-  const double hs = dtv_ / substeps;
+  int substeps = step_substeps();
+  double hs = dtv_ / substeps;
   std::vector<fibre::DetectedContact> found =
       detection_->contacts(bodies, dtv_, model.damping, model.may_bounce() || substeps > 1);
   fibre::SpookParams params{hs, model.damping, model.max_recovery(hs, r_min_)};
@@ -660,6 +681,14 @@ void FixFibreContact::final_integrate()
   if (any) {
     fibre::Vector warm = history_.warm_start(found, model.rows, hs);
     history_.load_springs(found, contacts);
+    // a step in which nothing moves takes one solve (substep_when moving)
+    if (substeps > 1 && model.substep_moving_only && !step_moves(bodies, contacts, hs)) {
+      substeps = 1;
+      hs = dtv_;
+      params = fibre::SpookParams{hs, model.damping, model.max_recovery(hs, r_min_)};
+      params.bounce_speed = bounce_speed(bodies, hs);
+      warm = history_.warm_start(found, model.rows, hs);
+    }
     const bool check = settings_.check_every > 0 && update->ntimestep % settings_.check_every == 0;
     std::vector<fibre::Body> bodies_at_start;
     std::vector<fibre::Contact> contacts_at_start;
@@ -718,6 +747,7 @@ void FixFibreContact::final_integrate()
   } else {
     output_->report_solve(res);
   }
+  output_->report_substeps(any ? steps.done : 0);
   if (do_export) // with substeps, the last one's system and warm start
     output_->export_step(settings_.export_prefix, sys, found, any ? &res.lambda : nullptr,
                          steps.warm, exchange_->local_owners());

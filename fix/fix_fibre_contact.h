@@ -71,6 +71,9 @@ class FixFibreContact : public Fix {
   void check_finite(const char *what, double **array, int nvalues) const;
   void smallest_body(const std::vector<fibre::Body> &bodies);
   double bounce_speed(const std::vector<fibre::Body> &bodies, double h) const;
+  double impact_speed(const std::vector<fibre::Body> &bodies, double h) const;
+  bool step_moves(const std::vector<fibre::Body> &bodies,
+                  const std::vector<fibre::Contact> &contacts, double hs) const;
   void follow_substeps(const fibre::Vector &path, int n, double hs);
   int step_substeps();
   double simulated_time() const;

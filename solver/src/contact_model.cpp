@@ -13,19 +13,31 @@ double cone_coefficient(const FrictionParams &f, double r_eff, int cone)
 
 namespace {
 
-// The contact's reduced mass (the sphere's against a wall) and its bodies' approach speed along
-// the normal (> 0 closing; a wall at its own velocity).
+// The contact's reduced mass (the sphere's against a wall).
 double effective_mass(const std::vector<Body> &bodies, const Contact &c)
 {
   const double ma = bodies[c.a].mass;
   return c.is_wall() ? ma : ma * bodies[c.b].mass / (ma + bodies[c.b].mass);
 }
 
+} // namespace
+
 double normal_approach(const std::vector<Body> &bodies, const Contact &c)
 {
   const Vec3 vb = c.is_wall() ? c.wall_v : bodies[c.b].v;
   return -(bodies[c.a].v - vb).dot(c.normal);
 }
+
+Vec3 relative_velocity(const std::vector<Body> &bodies, const Contact &c)
+{
+  const Body &a = bodies[c.a];
+  const Vec3 va = a.v + a.omega.cross(c.point - a.x);
+  if (c.is_wall()) return va - c.wall_v;
+  const Body &b = bodies[c.b];
+  return va - (b.v + b.omega.cross(c.point - b.x));
+}
+
+namespace {
 
 // Contact c's coefficients from its type pair's (pc), and with compliance material its rows'
 // compliances, springs and damping.

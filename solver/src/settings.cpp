@@ -265,6 +265,13 @@ std::size_t read_model_keyword(const Reader &in, std::size_t i, Settings &s)
         in.at(i + 1) == "auto" ? 0 : static_cast<int>(in.integer(i + 1, e, 1, kMaxSubsteps));
     return 2;
   }
+  if (key == "substep_when") {
+    const std::string e = "'substep_when always|moving'";
+    if (!in.has(i + 1)) Reader::illegal(e);
+    if (in.at(i + 1) != "always" && in.at(i + 1) != "moving") Reader::illegal(e, &in.at(i + 1));
+    s.model.substep_moving_only = in.at(i + 1) == "moving";
+    return 2;
+  }
   if (key == "substep_collisions") {
     s.model.substep_collisions =
         in.positive(i + 1, "'substep_collisions <positive number of collision times>'");
@@ -316,7 +323,9 @@ Settings parse_settings(const std::vector<std::string> &args)
           "compliance, damping, mu, mu_roll, mu_twist, rows, active_set, sweeps, "
           "sweep_tol, rescue_sweeps, min_sweeps, focus_sweeps, anderson, anderson_period, "
           "sweep_cg, sweep_blocks, sweep_groups, recovery_speed, restitution, bounce_speed, "
-          "coefficients, normal_relaxation, substeps, substep_collisions, wall, export, check)",
+          "coefficients, normal_relaxation, substeps, substep_collisions, substep_when, wall, "
+          "export, "
+          "check)",
           &key);
     i += used;
   }
@@ -363,6 +372,7 @@ std::string describe(const Settings &s)
          (s.model.substeps > 0
               ? std::to_string(s.model.substeps)
               : "auto (at most " + format_g(s.model.substep_collisions) + " t_c each)");
+  out += std::string(", substep_when ") + (s.model.substep_moving_only ? "moving" : "always");
   const FrictionParams &f = s.model.friction;
   return out + ", mu " + format_g(f.mu) + ", mu_roll " + format_g(f.mu_roll) + ", mu_twist " +
          format_g(f.mu_twist);

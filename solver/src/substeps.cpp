@@ -15,6 +15,20 @@ int substeps_for(const ContactModel &model, double h, double t_c)
   return static_cast<int>(std::clamp(n, 1.0, double(kMaxSubsteps)));
 }
 
+bool step_moves(const std::vector<Body> &bodies, const std::vector<Contact> &contacts,
+                const SpookParams &step, double speed)
+{
+  // A closing contact's SPOOK row acts once free flight would close more than its gap term
+  // allows, (4 / h) Upsilon g: within h / (4 Upsilon) of touching.
+  const double reach = step.h / (4.0 * step.upsilon());
+  for (const Contact &c : contacts) {
+    const double vn = normal_approach(bodies, c);      // > 0 closing
+    if (c.gap > 0 && !(c.gap <= reach * vn)) continue; // apart within the step: free flight
+    if (relative_velocity(bodies, c).norm() > speed) return true;
+  }
+  return false;
+}
+
 StepOptions check_options(const StepOptions &step)
 {
   StepOptions ref = step;

@@ -8,7 +8,8 @@ gravity, each sphere at v towards the other, at the decks' step of 4.43 ms (5 t_
   within 5% of native's e at 1 m/s (Newton's law at the substep that closes) and within 12% at
   0.05 m/s, below the automatic bounce speed, where the compliant rows resolve the collision
   (one solve a step, substeps 1, stops that pair dead, and the log warns of the step);
-- on two processes (one sphere on each) the rebounds are the serial ones within 1e-6.
+- on two processes (one sphere on each) the rebounds are the serial ones within 1e-6;
+- substep_when moving: one solve where nothing moves at a contact (in flight, at rest).
 """
 
 import os
@@ -62,7 +63,82 @@ def main():
             ck.check("Substeps longer than about a third of t_c" in one_run.output,
                      "v %g: substeps 1 at 5 t_c is warned of in the log" % v)
     plastic_pour(args, ck)
+    quiet_steps(args, ck)
     ck.close()
+
+
+DROP = """
+units       si
+atom_style  sphere
+atom_modify map array
+boundary    f f f
+newton      off
+comm_modify vel yes
+processors  ${px} 1 1
+region      box block -2 2 -1 1 0 2 units box
+create_box  1 box
+create_atoms 1 single -1 0 0.30 units box
+create_atoms 1 single 1 0 0.25 units box
+set         atom * diameter 0.5 density 1.0
+pair_style  granular
+pair_coeff  * * hertz/material 1e8 0.1 0.2857142857 tangential mindlin NULL 1.0 0.5 &
+            rolling sds 1.0e3 10.0 0.3 damping tsuji
+neighbor    0.3 bin
+neigh_modify delay 0 every 1 check yes
+timestep    0.0044343
+fix         g all gravity 9.81 vector 0 0 -1
+fix         fc all fibre_contact wall zplane 0.0 NULL ${fc_extra}
+variable    z1 equal z[1]
+variable    z2 equal z[2]
+variable    vz1 equal vz[1]
+thermo_style custom step v_z1 v_z2 v_vz1 f_fc[21]
+thermo_modify format float %.10g
+thermo      1
+run         200
+"""
+
+
+def quiet_steps(args, ck):
+    """substep_when moving: two spheres of the E = 1e8 law, one dropped from 5 cm onto the
+    floor, one set on it. The steps in which the first lands take the 16 substeps, the others
+    (in flight, at rest) one solve: f_fc[21] says which. Its rebound apex is native's e^2 h
+    within 15% (e 0.232 at 1 m/s), as with substep_when always (the default: every step 16
+    substeps; its flight follows the substeps, at most 0.1 mm a step apart from the plain
+    step's), and both come to rest at the same height within 1e-6 m; on two processes (one
+    sphere each) the trajectories are the serial ones within 1e-9 m."""
+    runs = {}
+    for tag, np, extra in (("moving", 1, "substep_when moving"), ("always", 1, ""),
+                           ("moving_np2", 2, "substep_when moving")):
+        run = e2e.run_lmp(args, DROP, "quiet_" + tag, np=np,
+                          variables={"fc_extra": extra, "px": np})
+        if not ck.ran(run):
+            return
+        runs[tag] = [r for b in run.thermo for r in b]
+    rows, always = runs["moving"], runs["always"]
+    counts = [int(r["f_fc[21]"]) for r in rows[1:]]
+    ck.check(set(counts) == {1, 16}, "substep_when moving: a step takes 16 substeps or one",
+             "%s" % sorted(set(counts)))
+    ck.check(0 < counts.count(16) < len(counts) // 4,
+             "the landings take the substeps, a few steps of 200",
+             "%d of %d" % (counts.count(16), len(counts)))
+    ck.check(counts[-20:] == [1] * 20, "both spheres at rest: one solve a step",
+             "%s" % counts[-20:])
+    ck.check(all(int(r["f_fc[21]"]) == 16 for r in always[1:]),
+             "substep_when always: every step 16 substeps")
+    apexes = []
+    for table in (rows, always):
+        first = next(k for k in range(1, len(table)) if table[k]["v_vz1"] > 0)
+        apexes.append(max(r["v_z1"] for r in table[first:first + 40]) - table[-1]["v_z1"])
+    e, h = 0.232, 0.05
+    for name, apex in zip(("moving", "always"), apexes):
+        ck.check(abs(apex - e * e * h) < 0.15 * e * e * h,
+                 "substep_when %s: the dropped sphere rebounds to e^2 h within 15%%" % name,
+                 "%.4g m against %.4g" % (apex, e * e * h))
+    rest = max(abs(rows[-1][c] - always[-1][c]) for c in ("v_z1", "v_z2"))
+    ck.check(rest < 1e-6, "at rest both at always's heights within 1e-6 m", "%.3g m" % rest)
+    worst = max(abs(a[c] - b[c]) for a, b in zip(rows, runs["moving_np2"])
+                for c in ("v_z1", "v_z2"))
+    ck.check(worst < 1e-9, "two processes: the serial trajectories", "%.3g m" % worst)
 
 
 def plastic_pour(args, ck):

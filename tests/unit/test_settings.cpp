@@ -66,7 +66,8 @@ TEST(Settings, NoKeywordsKeepTheDefaults)
       "compliance auto "
       "(0.01 dt^2 / m_min), recovery_speed auto (0.01 r_min / dt), restitution 0, "
       "bounce_speed auto (2 dt |f| / m max, or 0.01 r_min / dt without forces), coefficients "
-      "pair, normal_relaxation spook, substeps auto (at most 0.33 t_c each), mu 0.5, "
+      "pair, normal_relaxation spook, substeps auto (at most 0.33 t_c each), substep_when always, "
+      "mu 0.5, "
       "mu_roll 0, mu_twist 0");
 }
 

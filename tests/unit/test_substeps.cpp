@@ -198,3 +198,58 @@ TEST(Substeps, OneIsThePlainStepAndOnlyTheLastMeasuresItsResidual)
   EXPECT_GE(residuals[3], 0.0);
   EXPECT_EQ(four.totals.complementarity, residuals[3]);
 }
+
+// A step needs substeps where some contact moves (substep_when moving): its surfaces press,
+// part, slide or roll at more than the speed where they touch, or where they will touch within
+// its SPOOK row's reach, h (1 + 4 d) / 4 of the approach speed. A pile at rest, spheres that
+// fly apart or beyond reach and motion below the speed do not count.
+TEST(Substeps, OnlyAStepWithMotionAtAContactNeedsThem)
+{
+  const double h = 0.01, speed = 0.02;
+  SpookParams step;
+  step.h = h;
+  step.damping = 0.75; // SPOOK's row reaches h (1 + 4 d) / 4 = h ahead
+  std::vector<Body> bodies(2);
+  bodies[0].radius = bodies[1].radius = 0.5;
+  bodies[1].x = Vec3(0, 0, 1.0);
+  // a sphere over the floor, `gap` above it
+  const auto floor = [&](double gap) {
+    return std::vector<Contact>{sphere_wall_contact(bodies, 0, Vec3::UnitZ(), 0.5 + gap)};
+  };
+
+  bodies[0].v = Vec3(0, 0, -1.0); // falling at 1 m/s: reaches the floor within 10 ms from 9 mm
+  EXPECT_TRUE(step_moves(bodies, floor(0.009), step, speed));
+  EXPECT_FALSE(step_moves(bodies, floor(0.011), step, speed)); // beyond reach
+  EXPECT_TRUE(step_moves(bodies, floor(-0.001), step, speed)); // pressing on
+  step.damping = 2.0;                                          // the row brakes from 2.25 h
+  EXPECT_TRUE(step_moves(bodies, floor(0.022), step, speed));
+  EXPECT_FALSE(step_moves(bodies, floor(0.023), step, speed));
+  step.damping = 0.75;
+  bodies[0].v = Vec3(0, 0, -0.5 * speed); // below the speed: it rests on arrival
+  EXPECT_FALSE(step_moves(bodies, floor(0.0), step, speed));
+  bodies[0].v = Vec3(0, 0, 1.0); // leaving the floor
+  EXPECT_TRUE(step_moves(bodies, floor(-0.001), step, speed));
+  EXPECT_FALSE(step_moves(bodies, floor(0.001), step, speed)); // apart already
+  bodies[0].v = Vec3(0.1, 0, 0);                               // sliding on it
+  EXPECT_TRUE(step_moves(bodies, floor(-0.001), step, speed));
+  bodies[0].v = Vec3::Zero();
+  bodies[0].omega = Vec3(0, 0.2, 0); // rolling on it: its surface moves at 0.1 m/s there
+  EXPECT_TRUE(step_moves(bodies, floor(-0.001), step, speed));
+  bodies[0].omega = Vec3(0, 0, 0.2); // spinning about the normal: no surface motion there
+  EXPECT_FALSE(step_moves(bodies, floor(-0.001), step, speed));
+  bodies[0].v = Vec3(0.2, 0, 0);
+  bodies[0].omega = Vec3(0, 0.4, 0); // rolling without slip: the contact point rests
+  EXPECT_FALSE(step_moves(bodies, floor(-0.001), step, speed));
+  bodies[0].omega = Vec3::Zero();
+
+  // two spheres: the relative velocity counts, and so does a moving wall's
+  bodies[0].v = bodies[1].v = Vec3(0, 0, -3.0); // falling together
+  const std::vector<Contact> pair{sphere_sphere_contact(bodies, 1, 0)};
+  EXPECT_FALSE(step_moves(bodies, pair, step, speed));
+  bodies[1].v = Vec3(0, 0, -4.0);
+  EXPECT_TRUE(step_moves(bodies, pair, step, speed));
+  bodies[0].v = Vec3::Zero();
+  std::vector<Contact> wall = floor(0.005);
+  wall[0].wall_v = Vec3(0, 0, 1.0); // a floor that rises at 1 m/s
+  EXPECT_TRUE(step_moves(bodies, wall, step, speed));
+}

@@ -72,6 +72,9 @@ struct ContactModel {
   // material's law (one where the step is that short already, or there is no law).
   int substeps = 0;
   double substep_collisions = 0.33;
+  // Whether a step in which no contact moves (step_moves: a pile at rest) takes one solve
+  // instead of its substeps (keyword substep_when moving; always, the default: every step).
+  bool substep_moving_only = false;
   CoefficientSource coefficients = CoefficientSource::pair;
   NormalRelaxation normal_relaxation = NormalRelaxation::spook;
   TypedCoefficients typed{};
@@ -90,6 +93,12 @@ double cone_coefficient(const FrictionParams &f, double r_eff, int cone);
 
 // A last normal impulse at most this times m_eff (|v_n| + bounce_speed) is round-off, no load.
 inline constexpr double kRoundoffLoad = 1e-9;
+
+// Contact c's bodies' approach speed along the normal (> 0 closing; a wall at its own
+// velocity).
+double normal_approach(const std::vector<Body> &bodies, const Contact &c);
+// The velocity of a's surface relative to b's (or the wall's) at the contact point.
+Vec3 relative_velocity(const std::vector<Body> &bodies, const Contact &c);
 
 // Sets the per-row compliance, the friction coefficients and the restitution of every contact
 // (m_min: the lightest body of the simulation, read by automatic compliance only). With

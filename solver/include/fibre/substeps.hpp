@@ -23,6 +23,14 @@ namespace fibre {
 inline constexpr int kMaxSubsteps = 1000;
 int substeps_for(const ContactModel &model, double h, double t_c);
 
+// Whether some contact moves within the step (step.h, SPOOK's damping step.damping): its
+// surfaces slide, roll, press or part at more than `speed` where they touch or will within the
+// reach of the contact's SPOOK row, h (1 + 4 d) / 4 of their approach speed. A step without
+// (a pile at rest, spheres in free flight) has no collision for substeps to resolve
+// (substep_when rest). Local: a front end takes the answer of every process.
+bool step_moves(const std::vector<Body> &bodies, const std::vector<Contact> &contacts,
+                const SpookParams &step, double speed);
+
 // What a step's substeps did: the last one's system and solve, and the sums over all.
 struct Substeps {
   // The last substep's system (its bodies at that substep's start) and solve; the step's
