@@ -131,7 +131,7 @@ void apply_pair(const ContactModel &model, const PairCoefficients &pc, const Spo
 
 void apply_contact_model(const ContactModel &model, const SpookParams &params, double m_min,
                          const std::vector<Body> &bodies, std::vector<Contact> &contacts,
-                         const Vector *last)
+                         const Vector *last, const std::vector<double> *r_eff)
 {
   const double h = params.h;
   const ComplianceParams &p = model.compliance;
@@ -139,7 +139,7 @@ void apply_contact_model(const ContactModel &model, const SpookParams &params, d
   if (p.automatic || p.material) eps_n = eps_t = p.factor * h * h / m_min;
   for (std::size_t k = 0; k < contacts.size(); ++k) {
     Contact &c = contacts[k];
-    const double reff = effective_radius(bodies, c);
+    const double reff = r_eff ? (*r_eff)[k] : effective_radius(bodies, c);
     c.compliance[0] = eps_n;
     c.compliance[1] = c.compliance[2] = eps_t;
     for (int r = 3; r < kMaxRows; ++r) c.compliance[r] = eps_t / (reff * reff);

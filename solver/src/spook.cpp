@@ -32,23 +32,12 @@ Vector body_velocities(const ContactSystem &sys)
   return v;
 }
 
-Vector external_velocity_change(const ContactSystem &sys)
-{
-  Vector dv(sys.body_dofs());
-  const double h = sys.params().h;
-  for (int i = 0; i < sys.num_bodies(); ++i) {
-    dv.segment<3>(6 * i) = h * sys.bodies()[i].force;
-    dv.segment<3>(6 * i + 3) = h * sys.bodies()[i].torque;
-  }
-  return dv.cwiseProduct(sys.inv_mass());
-}
-
 Vector spook_rhs(const ContactSystem &sys, const Vector *extra_dv)
 {
   const SpookParams &p = sys.params();
   const double ups = p.upsilon();
   const Vector v = body_velocities(sys);
-  Vector w = (1.0 - ups) * v + external_velocity_change(sys);
+  Vector w = (1.0 - ups) * v + sys.external_velocity_change();
   if (extra_dv) w += *extra_dv;
   Vector b;
   g_apply(sys, w, b);
@@ -65,8 +54,9 @@ Vector spook_rhs(const ContactSystem &sys, const Vector *extra_dv)
     const Contact &k = sys.contacts()[c];
     const Eigen::Index row = Eigen::Index(rows) * c; // normal row
     const double ups_c = p.upsilon(p.damping_of(k));
-    double ups_r[kMaxRows]; // each row's Upsilon
-    for (int r = 0; r < rows; ++r) ups_r[r] = p.upsilon(p.damping_of(k, r));
+    double ups_r[kMaxRows]; // each row's Upsilon: the contact's but where a spring has its own
+    for (int r = 0; r < rows; ++r)
+      ups_r[r] = r > 0 && k.spring_damping[r] >= 0 ? p.upsilon(k.spring_damping[r]) : ups_c;
     if (k.own_damping()) // -(1 - Upsilon_r) G v on every row of the contact
       for (int r = 0; r < rows; ++r) b[row + r] += (ups_r[r] - ups) * Gv[row + r];
     // A moving wall is body b with a prescribed velocity, the same after the step:
@@ -117,14 +107,14 @@ Vector velocity_change(const ContactSystem &sys, const Exchange &ex, const Vecto
 
 Vector velocities_after(const ContactSystem &sys, const Exchange &ex, const Vector &lambda)
 {
-  Vector v_plus = body_velocities(sys) + external_velocity_change(sys);
+  Vector v_plus = body_velocities(sys) + sys.external_velocity_change();
   if (lambda.size() == sys.contact_dofs()) v_plus += velocity_change(sys, ex, lambda);
   return v_plus;
 }
 
 Vector velocities_after_change(const ContactSystem &sys, const Exchange &ex, Vector dv)
 {
-  Vector v_plus = body_velocities(sys) + external_velocity_change(sys);
+  Vector v_plus = body_velocities(sys) + sys.external_velocity_change();
   if (dv.size() == v_plus.size()) {
     ex.forward(dv);
     v_plus += dv;

@@ -266,11 +266,14 @@ void StepSolver::project(Vector &lambda) const
       Eigen::Vector2d t = cone_values(lambda, base(c), cone);
       if (tracked && state_[c].capped[k]) {
         t = radius * state_[c].dir[k];
-      } else if (t.squaredNorm() <= (1 - 1e-12) * radius * radius || t.norm() <= radius) {
-        continue; // inside (by a margin far above round-off: no square root; most cones stick)
       } else {
-        t = t.norm() > 0 && std::isfinite(t.norm()) ? Eigen::Vector2d(t * (radius / t.norm()))
-                                                    : Eigen::Vector2d::Zero();
+        // inside by a margin far above round-off: no square root (most cones stick)
+        const double squared = t.squaredNorm();
+        if (squared <= (1 - 1e-12) * radius * radius) continue;
+        const double tn = std::sqrt(squared);
+        if (tn <= radius) continue;
+        t = tn > 0 && std::isfinite(tn) ? Eigen::Vector2d(t * (radius / tn))
+                                        : Eigen::Vector2d::Zero();
       }
       set_cone(lambda, base(c), cone, t);
     }
@@ -477,7 +480,7 @@ StepResult StepSolver::run(const Vector *warm)
         res.sweep_reason == StopReason::converged ? StopReason::stagnation : res.sweep_reason;
   }
   if (opt_.residual) count_set(lambda, res);
-  sys_.set_rhs(b_full_);
+  sys_.set_rhs(std::move(b_full_));
   res.dv = body_from_lambda(sys_, ex_, lambda);
   res.lambda = std::move(lambda);
   res.total_seconds = seconds_since(t_start);

@@ -89,11 +89,10 @@ Substeps run_substeps(int n, const ContactModel &model, const SpookParams &param
               b[i].v = v_plus.segment<3>(6 * Eigen::Index(i));
               b[i].omega = v_plus.segment<3>(6 * Eigen::Index(i) + 3);
             }
-            apply_contact_model(model, params, m_min, b, c, &warm);
+            apply_contact_model(model, params, m_min, b, c, &warm, &sys.effective_radii());
           },
           std::move(Gv_plus));
     }
-    out.warm = warm;
     StepResult res = solve(sys, warm, last, cache);
     const bool solved = res.dv.size() == sys.body_dofs();
     if (out.done == 0)
@@ -102,6 +101,7 @@ Substeps run_substeps(int n, const ContactModel &model, const SpookParams &param
       add_solve(out.totals, res);
     ++out.done;
     out.result = std::move(res);
+    if (!solved || last) out.warm = std::move(warm); // the last solve's
     if (!solved) break;
     const StepResult &r = out.result;
     out.v_plus = velocities_after_change(sys, ex, r.dv);
@@ -120,7 +120,7 @@ Substeps run_substeps(int n, const ContactModel &model, const SpookParams &param
       out.path += out.v_plus;
       out.lambda += r.lambda;
     }
-    warm = r.lambda;
+    if (!last) warm = std::move(out.result.lambda); // the next substep's; this one is not kept
   }
   return out;
 }

@@ -116,6 +116,12 @@ void ContactSystem::compute_derived()
     inv_mass_.segment<3>(6 * i + 3).setConstant(1.0 / inertia);
   }
   mass_ = inv_mass_.cwiseInverse();
+  external_dv_.resize(Eigen::Index(kBodyDofs) * nb);
+  for (int i = 0; i < nb; ++i) {
+    external_dv_.segment<3>(6 * i) = params_.h * bodies_[i].force;
+    external_dv_.segment<3>(6 * i + 3) = params_.h * bodies_[i].torque;
+  }
+  external_dv_.array() *= inv_mass_.array();
   kin_.resize(nc);
   sigma_.resize(contact_dofs());
   pairs_.resize(std::size_t(2) * nc);

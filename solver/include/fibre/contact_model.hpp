@@ -109,8 +109,10 @@ Vec3 relative_velocity(const std::vector<Body> &bodies, const Contact &c);
 // enduring contact, not an impact, and gets no restitution; one at round-off (kRoundoffLoad)
 // counts as none. `params` gives the step h and the bounce speed: an impact that bounces has
 // its springs for its collision time only.
+// `r_eff` (optional): the contacts' effective radii, where the caller has them
+// (ContactSystem::effective_radii).
 void apply_contact_model(const ContactModel &model, const SpookParams &params, double m_min,
                          const std::vector<Body> &bodies, std::vector<Contact> &contacts,
-                         const Vector *last = nullptr);
+                         const Vector *last = nullptr, const std::vector<double> *r_eff = nullptr);
 
 } // namespace fibre

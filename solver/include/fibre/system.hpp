@@ -8,6 +8,7 @@
 #include <Eigen/Dense>
 #include <array>
 #include <cstdint>
+#include <utility>
 #include <vector>
 
 namespace fibre {
@@ -219,14 +220,18 @@ class ContactSystem {
   // Derived once per system: the substeps of a step share them.
   const std::array<Vec6, 2> &diagonal_sides(int c) const { return sides_[c]; }
   double effective_radius(int c) const { return r_eff_[c]; }
+  const std::vector<double> &effective_radii() const { return r_eff_; }
   // Whether some contact's wall or obstacle moves (Contact::wall_moves): else every wall_rows
   // is zero, and the passes that would read them skip the contacts.
   bool walls_move() const { return walls_move_; }
   const Vector &inv_mass() const { return inv_mass_; } // diagonal of M^-1, 6 per body
-  const Vector &mass() const { return mass_; }         // diagonal of M, 6 per body
-  const Vector &sigma() const { return sigma_; }       // diagonal of Sigma, rows per contact
+  // h M^-1 (force, torque) of every body: the external forces' velocity change in a step.
+  const Vector &external_velocity_change() const { return external_dv_; }
+  const Vector &mass() const { return mass_; }   // diagonal of M, 6 per body
+  const Vector &sigma() const { return sigma_; } // diagonal of Sigma, rows per contact
   const Vector &rhs() const { return rhs_; }
   void set_rhs(const Vector &b) { rhs_ = b; }
+  void set_rhs(Vector &&b) { rhs_ = std::move(b); }
   // The coefficients of contact c, or of every contact (they enter no derived quantity).
   void set_friction(int c, const FrictionParams &f) { contacts_[c].friction = f; }
   void set_friction(const FrictionParams &f);
@@ -245,11 +250,11 @@ class ContactSystem {
   void set_row_mask(const std::vector<unsigned char> &active); // 1 = active row
 
   // The next substep of a step (substeps.hpp), in place: the bodies' velocities and the
-  // contacts' gaps, springs, compliances and damping change; the bodies' positions and masses
-  // and the contacts' bodies, frames and points do not, so the kinematics hold. `edit` changes
-  // them; Sigma then follows the new compliances and damping.
-  // velocity_rows: G times the new velocities, which the caller has (the last substep's G v+);
-  // taken over after the edit, which may read it.
+  // contacts' gaps, springs, compliances and damping change; the bodies' positions, masses and
+  // external forces and the contacts' bodies, frames and points do not, so the kinematics hold.
+  // `edit` changes them; Sigma then follows the new compliances and damping. velocity_rows: G times
+  // the new velocities, which the caller has (the last substep's G v+); taken over after the edit,
+  // which may read it.
   template <typename Edit> void next_substep(Edit &&edit, Vector &&velocity_rows)
   {
     edit(bodies_, contacts_);
@@ -278,6 +283,7 @@ class ContactSystem {
   std::vector<unsigned char> mask_; // empty = all rows active
   Vector inv_mass_;
   Vector mass_;
+  Vector external_dv_;
   Vector sigma_;
   Vector inv_sigma_;
   Vector row_weight_;      // empty = all rows active
