@@ -26,7 +26,7 @@ def deck(args):
         shutil.copy(os.path.join(source, name), args.workdir)
     with open(os.path.join(source, "in.material")) as f:
         text = f.read()
-    text = re.sub(r"(?m)^variable\s+fibre_thermo string .*$",
+    text = re.sub(r"(?m)^variable\s+fibre_thermo (?:string|index) .*$",
                   'variable  fibre_thermo string "f_fc[3] f_fc[19] f_fc[20]"', text)
     # two processes split the pile (the box is tallest in z, where LAMMPS would cut it)
     return "processors * 1 1\n" + text
