@@ -38,7 +38,7 @@ enum Stat {
   V_DISSIPATION,    // cumulative, likewise
   V_CHECK_VELOCITY, // the last check's errors against the converged step (keyword check)
   V_CHECK_IMPULSE,
-  V_SUBSTEPS, // the last step's contact solves (substeps; 1 where it had no collision)
+  V_SUBSTEPS, // the last step's contact solves (its substeps; 1 where nothing moved)
   V_SIZE
 };
 

@@ -324,8 +324,7 @@ Settings parse_settings(const std::vector<std::string> &args)
           "sweep_tol, rescue_sweeps, min_sweeps, focus_sweeps, anderson, anderson_period, "
           "sweep_cg, sweep_blocks, sweep_groups, recovery_speed, restitution, bounce_speed, "
           "coefficients, normal_relaxation, substeps, substep_collisions, substep_when, wall, "
-          "export, "
-          "check)",
+          "export, check)",
           &key);
     i += used;
   }

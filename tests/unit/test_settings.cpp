@@ -238,6 +238,11 @@ TEST(Settings, BadInputNamesTheKeywordAndItsForm)
   EXPECT_EQ(parse_settings(words("substeps 7")).model.substeps, 7);
   EXPECT_EQ(parse_settings(words("substeps 7 substeps auto")).model.substeps, 0);
   EXPECT_DOUBLE_EQ(parse_settings(words("substep_collisions 0.3")).model.substep_collisions, 0.3);
+  EXPECT_EQ(error_of("substep_when rest"), "expected 'substep_when always|moving', got 'rest'");
+  EXPECT_EQ(error_of("substep_when"), "expected 'substep_when always|moving'");
+  EXPECT_TRUE(parse_settings(words("substep_when moving")).model.substep_moving_only);
+  EXPECT_FALSE(
+      parse_settings(words("substep_when moving substep_when always")).model.substep_moving_only);
   EXPECT_NE(error_of("speed 3").find("expected a keyword (form, solver"), std::string::npos);
   EXPECT_NE(error_of("speed 3").find("got 'speed'"), std::string::npos);
 }

@@ -12,7 +12,6 @@ namespace fibre {
 
 // Per-body velocity vector (v, omega) stacked, 6 per body.
 Vector body_velocities(const ContactSystem &sys);
-// h M^-1 f_ext per body, the free-flight velocity change: ContactSystem::external_velocity_change.
 
 // b = -(4/h) Upsilon g - (1 - Upsilon) G v - G (h M^-1 f_ext + extra_dv), g the gap on normal
 // rows and the spring's displacement on elastic rows.

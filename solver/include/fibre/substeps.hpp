@@ -27,7 +27,7 @@ int substeps_for(const ContactModel &model, double h, double t_c);
 // surfaces slide, roll, press or part at more than `speed` where they touch or will within the
 // reach of the contact's SPOOK row, h (1 + 4 d) / 4 of their approach speed. A step without
 // (a pile at rest, spheres in free flight) has no collision for substeps to resolve
-// (substep_when rest). Local: a front end takes the answer of every process.
+// (substep_when moving). Local: a front end takes the answer of every process.
 bool step_moves(const std::vector<Body> &bodies, const std::vector<Contact> &contacts,
                 const SpookParams &step, double speed);
 
