@@ -100,7 +100,7 @@ int main()
         });
       };
       const double tk = k_product_seconds(sys, 51);
-      const StepState state{sys, ref.lambda, warm};
+      const StepState state{sys, ref.lambda, warm, nullptr};
       double default_k = -1;
       for (int s = 0; s <= 200000; s = s < 8 ? s + 1 : s + s / 4) {
         StepOptions opt;
