@@ -665,8 +665,12 @@ void FixFibreContact::final_integrate()
   double hs = dtv_ / substeps;
   std::vector<fibre::DetectedContact> found =
       detection_->contacts(bodies, dtv_, model.damping, model.may_bounce() || substeps > 1);
-  fibre::SpookParams params{hs, model.damping, model.max_recovery(hs, r_min_)};
-  params.bounce_speed = bounce_speed(bodies, hs);
+  const auto params_of = [&](double h) {
+    fibre::SpookParams p{h, model.damping, model.max_recovery(h, r_min_)};
+    p.bounce_speed = bounce_speed(bodies, h);
+    return p;
+  };
+  fibre::SpookParams params = params_of(hs);
   if (first_step_) warn_deep_overlaps(bodies, found, params.max_recovery);
   first_step_ = false;
   const bool any = output_->count_contacts(found) > 0;
@@ -685,8 +689,7 @@ void FixFibreContact::final_integrate()
     if (substeps > 1 && model.substep_moving_only && !step_moves(bodies, contacts, hs)) {
       substeps = 1;
       hs = dtv_;
-      params = fibre::SpookParams{hs, model.damping, model.max_recovery(hs, r_min_)};
-      params.bounce_speed = bounce_speed(bodies, hs);
+      params = params_of(hs);
       warm = history_.warm_start(found, model.rows, hs);
     }
     const bool check = settings_.check_every > 0 && update->ntimestep % settings_.check_every == 0;

@@ -10,14 +10,13 @@ namespace fibre {
 namespace {
 
 // G v of the bodies' velocities: the substep's, where next_substep gave it and no row is
-// masked (ContactSystem::velocity_rows), else the product.
-Vector start_rows(const ContactSystem &sys)
+// masked (ContactSystem::velocity_rows), else the product, computed into `own`.
+const Vector &start_rows(const ContactSystem &sys, Vector &own)
 {
   if (sys.row_mask().empty() && sys.velocity_rows().size() == sys.contact_dofs())
     return sys.velocity_rows();
-  Vector Gv;
-  g_apply(sys, body_velocities(sys), Gv);
-  return Gv;
+  g_apply(sys, body_velocities(sys), own);
+  return own;
 }
 
 } // namespace
@@ -42,13 +41,13 @@ Vector spook_rhs(const ContactSystem &sys, const Vector *extra_dv)
   Vector b;
   g_apply(sys, w, b);
   b = -b;
-  // G v, where a contact bounces or has its own damping
-  Vector Gv;
-  for (const Contact &k : sys.contacts())
-    if (k.restitution > 0 || k.own_damping() || k.wall_moves() || k.implicit_normal) {
-      Gv = start_rows(sys);
-      break;
-    }
+  // G v, where a contact bounces or has its own damping (else empty)
+  const bool needs_Gv =
+      std::any_of(sys.contacts().begin(), sys.contacts().end(), [](const Contact &k) {
+        return k.restitution > 0 || k.own_damping() || k.wall_moves() || k.implicit_normal;
+      });
+  Vector own;
+  const Vector &Gv = needs_Gv ? start_rows(sys, own) : own;
   const int rows = sys.rows();
   for (int c = 0; c < sys.num_contacts(); ++c) {
     const Contact &k = sys.contacts()[c];
@@ -126,7 +125,8 @@ ContactWork contact_work(const ContactSystem &sys, const Vector &Gv_plus, const 
 {
   ContactWork work;
   if (lambda.size() != sys.contact_dofs()) return work;
-  const Vector Gv = start_rows(sys);
+  Vector own;
+  const Vector &Gv = start_rows(sys, own);
   const int rows = sys.rows();
   const std::array<double, kMaxRows> at_rest{};
   for (int c = 0; c < sys.num_contacts(); ++c) {
@@ -149,7 +149,9 @@ std::vector<std::array<double, kMaxRows>> advance_springs(const ContactSystem &s
 {
   const int rows = sys.rows(), nc = sys.num_contacts();
   std::vector<std::array<double, kMaxRows>> springs(nc);
-  Vector own, Gv0; // Gv0: G v at the step's start, for the springs with a damper of their own
+  Vector own, own0;
+  const Vector *Gv0 =
+      nullptr; // G v at the step's start, for the springs with a damper of their own
   if (!Gv_plus) g_apply(sys, v_plus, own);
   const Vector &Gv = Gv_plus ? *Gv_plus : own;
   const double h = sys.params().h;
@@ -196,10 +198,10 @@ std::vector<std::array<double, kMaxRows>> advance_springs(const ContactSystem &s
         // the spring keeps that last share back, or a rolling sphere falls short of the cone's
         // torque (by 13% at the decks' step).
         if (ln > 0 && tau > 0) {
-          if (Gv0.size() == 0) Gv0 = start_rows(sys);
+          if (!Gv0) Gv0 = &start_rows(sys, own0);
           Eigen::Vector2d w0 = Eigen::Vector2d::Zero();
           for (int i = 0; i < rows_of.size; ++i)
-            w0[i] = Gv0[base + rows_of.first + i] - wall[rows_of.first + i];
+            w0[i] = (*Gv0)[base + rows_of.first + i] - wall[rows_of.first + i];
           const double speed = w.norm();
           if (speed > 0) {
             const double d = sys.params().damping_of(k, rows_of.first);
