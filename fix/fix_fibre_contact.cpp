@@ -98,9 +98,10 @@ FixFibreContact::FixFibreContact(LAMMPS *lmp, int narg, char **arg) : Fix(lmp, n
   comm_forward = fibre_lmp::LammpsExchange::kValuesPerAtom;
   comm_reverse = fibre_lmp::LammpsExchange::kValuesPerAtom;
 #ifdef FIBRE_HOST_LIGGGHTS
-  comm->maxexchange_fix = std::max(comm->maxexchange_fix, fibre::ContactHistory::kMaxPacked);
+  comm->maxexchange_fix =
+      std::max(comm->maxexchange_fix, fibre::ContactHistory::kMaxPacked + kPendingValues);
 #else
-  maxexchange = fibre::ContactHistory::kMaxPacked;
+  maxexchange = fibre::ContactHistory::kMaxPacked + kPendingValues;
 #endif
   // the contact forces' virial enters compute pressure and compute stress/atom
 #ifdef FIBRE_HOST_LIGGGHTS
@@ -409,7 +410,8 @@ void FixFibreContact::reset_dt()
 }
 
 /* ----------------------------------------------------------------------
-   positions: x += dt v, with v the velocities after the last contact solve
+   positions: x += dt v, with v the velocities after the last contact solve, after the last
+   step's substeps' displacement beyond it (follow_substeps)
 ------------------------------------------------------------------------- */
 
 void FixFibreContact::initial_integrate(int /*vflag*/)
@@ -418,7 +420,28 @@ void FixFibreContact::initial_integrate(int /*vflag*/)
   const int *mask = atom->mask;
   for (int i = 0; i < atom->nlocal; ++i)
     if (mask[i] & groupbit)
-      for (int d = 0; d < 3; ++d) x[i][d] += dtv_ * v[i][d];
+      for (int d = 0; d < 3; ++d) {
+        x[i][d] += pending_[i][d];
+        pending_[i][d] = 0.0;
+        x[i][d] += dtv_ * v[i][d];
+      }
+}
+
+// Between runs the positions take the substeps' displacement in: the next run's first step
+// adds dt v only, and write_restart, write_data or a changed step may come between.
+void FixFibreContact::post_run()
+{
+  add_pending();
+}
+
+void FixFibreContact::add_pending()
+{
+  double **x = atom->x;
+  for (int i = 0; i < atom->nlocal; ++i)
+    for (int d = 0; d < 3; ++d) {
+      x[i][d] += pending_[i][d];
+      pending_[i][d] = 0.0;
+    }
 }
 
 /* ---------------------------------------------------------------------- */
@@ -524,15 +547,16 @@ bool FixFibreContact::step_moves(const std::vector<fibre::Body> &bodies,
 
 // With substeps the positions follow the substeps' velocities, x_{n+1} = x_n + hs sum_k v_k,
 // so that the gaps the substeps moved are the gaps the next step detects. initial_integrate
-// adds dtv v_final; the rest goes in now (path: the sum of the n substeps' velocities, the
-// final one's last). A body at rest or in free flight of one velocity moves as without.
+// adds dtv v_final and the rest, kept until then (path: the sum of the n substeps'
+// velocities, the final one's last), so that dumps and computes between steps see x_n. A
+// body at rest or in free flight of one velocity moves as without.
 void FixFibreContact::follow_substeps(const fibre::Vector &path, int n, double hs)
 {
-  double **x = atom->x, **v = atom->v;
+  double **v = atom->v;
   const std::vector<int> &body_atom = exchange_->body_atom();
   for (int k = 0; k < exchange_->num_owned(); ++k) {
     const int i = body_atom[k];
-    for (int d = 0; d < 3; ++d) x[i][d] += hs * path[6 * k + d] - n * hs * v[i][d];
+    for (int d = 0; d < 3; ++d) pending_[i][d] = hs * path[6 * k + d] - n * hs * v[i][d];
   }
 }
 
@@ -793,32 +817,43 @@ void FixFibreContact::restart(char *buf)
 void FixFibreContact::grow_arrays(int nmax)
 {
   history_.grow(nmax);
+  pending_.resize(std::max<std::size_t>(pending_.size(), nmax), {0.0, 0.0, 0.0});
 }
 
 void FixFibreContact::copy_arrays(int i, int j, int /*delflag*/)
 {
   history_.copy(i, j);
+  pending_[j] = pending_[i];
 }
 
 void FixFibreContact::set_arrays(int i)
 {
   history_.clear(i);
+  pending_[i] = {0.0, 0.0, 0.0};
 }
 
+// [the history, the pending displacement]
 int FixFibreContact::pack_exchange(int i, double *buf)
 {
-  return history_.pack(i, buf);
+  const int m = history_.pack(i, buf);
+  std::copy(pending_[i].begin(), pending_[i].end(), buf + m);
+  return m + kPendingValues;
 }
 
 int FixFibreContact::unpack_exchange(int nlocal, double *buf)
 {
-  return history_.unpack(nlocal, buf);
+  const int m = history_.unpack(nlocal, buf);
+  std::copy(buf + m, buf + m + kPendingValues, pending_[nlocal].begin());
+  return m + kPendingValues;
 }
 
-// buf[0] = number of values including itself, as other fixes read it
+// [number of values including itself, as other fixes read it; the history; the pending
+// displacement] (a restart written within a run, after a step with substeps)
 int FixFibreContact::pack_restart(int i, double *buf)
 {
-  const int m = 1 + history_.pack(i, buf + 1);
+  int m = 1 + history_.pack(i, buf + 1);
+  std::copy(pending_[i].begin(), pending_[i].end(), buf + m);
+  m += kPendingValues;
   buf[0] = m;
   return m;
 }
@@ -829,22 +864,29 @@ void FixFibreContact::unpack_restart(int nlocal, int nth)
   int m = 0;
   for (int k = 0; k < nth; ++k) m += static_cast<int>(extra[m]);
   const int count = static_cast<int>(extra[m]);
-  // restart files written before the springs hold 7 values per slot
   const int n = static_cast<int>(extra[m + 1]);
-  const int slot = n > 0 && count - 2 == n * fibre::ContactHistory::kWarmStartSlot
-                       ? fibre::ContactHistory::kWarmStartSlot
-                       : fibre::ContactHistory::kSlotSize;
-  history_.unpack(nlocal, extra + m + 1, count - 2, slot);
+  using fibre::ContactHistory;
+  // restart files written before session 46 hold no pending displacement, and those written
+  // before the springs 7 values per slot
+  const bool pending = count - 2 - kPendingValues == n * ContactHistory::kSlotSize;
+  const int values = count - 2 - (pending ? kPendingValues : 0);
+  const int slot = n > 0 && values == n * ContactHistory::kWarmStartSlot
+                       ? ContactHistory::kWarmStartSlot
+                       : ContactHistory::kSlotSize;
+  history_.unpack(nlocal, extra + m + 1, values, slot);
+  pending_[nlocal] = {0.0, 0.0, 0.0};
+  if (pending)
+    std::copy(extra + m + count - kPendingValues, extra + m + count, pending_[nlocal].begin());
 }
 
 int FixFibreContact::size_restart(int i)
 {
-  return 1 + history_.packed_size(i);
+  return 1 + history_.packed_size(i) + kPendingValues;
 }
 
 int FixFibreContact::maxsize_restart()
 {
-  return 1 + fibre::ContactHistory::kMaxPacked;
+  return 1 + fibre::ContactHistory::kMaxPacked + kPendingValues;
 }
 
 /* ----------------------------------------------------------------------
@@ -887,5 +929,6 @@ int FixFibreContact::pack_reverse_comm_size(int n, int /*first*/)
 
 double FixFibreContact::memory_usage()
 {
-  return history_.memory_bytes() + output_->memory_bytes();
+  return history_.memory_bytes() + output_->memory_bytes() +
+         double(pending_.capacity()) * sizeof(pending_[0]);
 }

@@ -6,7 +6,9 @@
 #ifndef LMP_FIX_FIBRE_CONTACT_H
 #define LMP_FIX_FIBRE_CONTACT_H
 
+#include <array>
 #include <memory>
+#include <vector>
 
 #include "fibre/contact_history.hpp"
 #include "fibre/settings.hpp"
@@ -31,6 +33,7 @@ class FixFibreContact : public Fix {
   void initial_integrate(int) override;
   void post_force(int) override;
   void final_integrate() override;
+  void post_run() override;
   void reset_dt() override;
 
   double compute_vector(int) override;
@@ -103,6 +106,11 @@ class FixFibreContact : public Fix {
   std::unique_ptr<fibre_lmp::LammpsDetection> detection_;
   std::unique_ptr<fibre_lmp::FibreOutput> output_;
   fibre::ContactHistory history_;
+  // Per atom: the substeps' displacement beyond dt v (follow_substeps), added at the next
+  // step's start, so that between steps the positions are the step's own.
+  std::vector<std::array<double, 3>> pending_;
+  static constexpr int kPendingValues = 3;
+  void add_pending();
   long overflow_count_ = 0;
   bool overflow_warned_ = false;
 };

@@ -64,6 +64,7 @@ def main():
                      "v %g: substeps 1 at 5 t_c is warned of in the log" % v)
     plastic_pour(args, ck)
     quiet_steps(args, ck)
+    restart_after_landing(args, ck)
     ck.close()
 
 
@@ -91,7 +92,7 @@ fix         fc all fibre_contact wall zplane 0.0 NULL ${fc_extra}
 variable    z1 equal z[1]
 variable    z2 equal z[2]
 variable    vz1 equal vz[1]
-thermo_style custom step v_z1 v_z2 v_vz1 f_fc[21]
+thermo_style custom step v_z1 v_z2 v_vz1 f_fc[21] f_fc[7]
 thermo_modify format float %.10g
 thermo      1
 run         200
@@ -105,7 +106,10 @@ def quiet_steps(args, ck):
     within 15% (e 0.232 at 1 m/s), as with substep_when always (the default: every step 16
     substeps; its flight follows the substeps, at most 0.1 mm a step apart from the plain
     step's), and both come to rest at the same height within 1e-6 m; on two processes (one
-    sphere each) the trajectories are the serial ones within 1e-9 m."""
+    sphere each) the trajectories are the serial ones within 1e-9 m. Between steps (the thermo
+    line) the positions are those the step detected its contacts at: the deepest floor overlap
+    they show is the step's f_fc[7], also in the steps whose substeps land and bounce (the
+    substeps' displacement is added at the next step's start, not before the output)."""
     runs = {}
     for tag, np, extra in (("moving", 1, "substep_when moving"), ("always", 1, ""),
                            ("moving_np2", 2, "substep_when moving")):
@@ -127,18 +131,64 @@ def quiet_steps(args, ck):
              "substep_when always: every step 16 substeps")
     apexes = []
     for table in (rows, always):
-        first = next(k for k in range(1, len(table)) if table[k]["v_vz1"] > 0)
+        # the landing step's line: its velocity is the bounce's, its position the step's start
+        first = next(k for k in range(1, len(table)) if table[k]["v_vz1"] > 0) + 1
         apexes.append(max(r["v_z1"] for r in table[first:first + 40]) - table[-1]["v_z1"])
     e, h = 0.232, 0.05
     for name, apex in zip(("moving", "always"), apexes):
         ck.check(abs(apex - e * e * h) < 0.15 * e * e * h,
                  "substep_when %s: the dropped sphere rebounds to e^2 h within 15%%" % name,
                  "%.4g m against %.4g" % (apex, e * e * h))
+    radius = 0.25
+    for name, table in (("moving", rows), ("always", always)):
+        shown = [max(0.0, radius - r["v_z1"], radius - r["v_z2"]) for r in table[1:]]
+        worst = max(abs(a - r["f_fc[7]"]) for a, r in zip(shown, table[1:]))
+        ck.check(worst < 1e-9, "substep_when %s: the positions between steps are the step's, "
+                 "their floor overlap its f_fc[7]" % name, "%.3g m off" % worst)
     rest = max(abs(rows[-1][c] - always[-1][c]) for c in ("v_z1", "v_z2"))
     ck.check(rest < 1e-6, "at rest both at always's heights within 1e-6 m", "%.3g m" % rest)
     worst = max(abs(a[c] - b[c]) for a, b in zip(rows, runs["moving_np2"])
                 for c in ("v_z1", "v_z2"))
     ck.check(worst < 1e-9, "two processes: the serial trajectories", "%.3g m" % worst)
+
+
+RESUME = """
+atom_modify map array
+processors  1 1 1
+read_restart drop.23.restart
+neighbor    0.3 bin
+neigh_modify delay 0 every 1 check yes
+comm_modify vel yes
+fix         g all gravity 9.81 vector 0 0 -1
+fix         fc all fibre_contact wall zplane 0.0 NULL
+variable    z1 equal z[1]
+variable    z2 equal z[2]
+variable    vz1 equal vz[1]
+thermo_style custom step v_z1 v_z2 v_vz1 f_fc[21] f_fc[7]
+thermo_modify format float %.10g
+thermo      1
+run         177
+"""
+
+
+def restart_after_landing(args, ck):
+    """A restart file written within a run, at the end of the step whose substeps land the
+    dropped sphere and bounce it (step 23), continues the run's trajectory: the substeps'
+    displacement still to be added at the next step's start is in the file."""
+    deck = DROP.replace("run         200", "restart     23 drop.*.restart\nrun         200")
+    full = e2e.run_lmp(args, deck, "restart_full", variables={"fc_extra": "", "px": 1})
+    if not ck.ran(full):
+        return
+    rest = e2e.run_lmp(args, RESUME, "restart_resumed")
+    if not ck.ran(rest):
+        return
+    a = {int(r["Step"]): r for b in full.thermo for r in b}
+    b = {int(r["Step"]): r for blk in rest.thermo for r in blk}
+    steps = [n for n in range(24, 201) if n in a and n in b]
+    worst = max(abs(a[n][c] - b[n][c]) for n in steps for c in ("v_z1", "v_z2", "v_vz1"))
+    ck.check(len(steps) == 177 and worst < 1e-12,
+             "a restart written after a landing step continues the run's trajectory",
+             "%d steps, %.3g off" % (len(steps), worst))
 
 
 def plastic_pour(args, ck):
