@@ -22,6 +22,7 @@
 """
 
 import math
+import os
 import re
 
 import fibre_e2e as e2e
@@ -203,9 +204,29 @@ def collision_log(ck, run, tag):
                                                              DT / t_c))
 
 
+def incline_example(args, ck, np):
+    """examples/incline/in.incline, the shipped example of two materials: type 1 slides at
+    g (sin - 0.2 cos) within 1%, type 2 sticks (below 1e-4 of the free slide's speed)."""
+    with open(os.path.join(args.source, "examples", "incline", "in.incline")) as f:
+        deck = f.read()
+    tag = "example_incline_np%d" % np
+    run = e2e.run_lmp(args, deck, tag, np=np, variables={"px": np})
+    if not ck.ran(run, "%s: run completes" % tag):
+        return
+    found = re.findall(r"^incline: type 1 vx (\S+) \(g \(sin - 0.2 cos\) t = (\S+)\), "
+                       r"type 2 vx (\S+)$", run.output, re.M)
+    if not ck.check(bool(found), "%s: the deck prints both speeds" % tag):
+        return
+    v1, slide, v2 = (float(x) for x in found[-1])
+    ck.agree(v1, slide, 1e-2, "%s: type 1 (mu 0.2) slides at g (sin - 0.2 cos)" % tag)
+    ck.check(abs(v2) < 1e-4 * slide, "%s: type 2 (mu 0.8) sticks" % tag, "vx %.3g" % v2)
+
+
 def main():
     args = e2e.parse_args()
     ck = e2e.Checks("coefficients per type pair")
+    incline_example(args, ck, 1)
+    incline_example(args, ck, 2)
     run = incline(args, ck, "incline_types", GRANULAR, "", [(True, 0.2), (False, 0.8)])
     if run.rc == 0:
         ck.check("1 1: mu 0.2, mu_roll 1, twisting none, restitution 0.439" in run.output and
