@@ -431,11 +431,6 @@ void FixFibreContact::initial_integrate(int /*vflag*/)
 // adds dt v only, and write_restart, write_data or a changed step may come between.
 void FixFibreContact::post_run()
 {
-  add_pending();
-}
-
-void FixFibreContact::add_pending()
-{
   double **x = atom->x;
   for (int i = 0; i < atom->nlocal; ++i)
     for (int d = 0; d < 3; ++d) {

@@ -110,7 +110,6 @@ class FixFibreContact : public Fix {
   // step's start, so that between steps the positions are the step's own.
   std::vector<std::array<double, 3>> pending_;
   static constexpr int kPendingValues = 3;
-  void add_pending();
   long overflow_count_ = 0;
   bool overflow_warned_ = false;
 };

@@ -152,6 +152,7 @@ def quiet_steps(args, ck):
     ck.check(worst < 1e-9, "two processes: the serial trajectories", "%.3g m" % worst)
 
 
+# the same spheres continued from the restart file of step 23, with the drop's fixes and output
 RESUME = """
 atom_modify map array
 processors  1 1 1
@@ -159,16 +160,7 @@ read_restart drop.23.restart
 neighbor    0.3 bin
 neigh_modify delay 0 every 1 check yes
 comm_modify vel yes
-fix         g all gravity 9.81 vector 0 0 -1
-fix         fc all fibre_contact wall zplane 0.0 NULL
-variable    z1 equal z[1]
-variable    z2 equal z[2]
-variable    vz1 equal vz[1]
-thermo_style custom step v_z1 v_z2 v_vz1 f_fc[21] f_fc[7]
-thermo_modify format float %.10g
-thermo      1
-run         177
-"""
+""" + DROP[DROP.index("fix         g"):].replace("run         200", "run         177")
 
 
 def restart_after_landing(args, ck):
@@ -179,7 +171,7 @@ def restart_after_landing(args, ck):
     full = e2e.run_lmp(args, deck, "restart_full", variables={"fc_extra": "", "px": 1})
     if not ck.ran(full):
         return
-    rest = e2e.run_lmp(args, RESUME, "restart_resumed")
+    rest = e2e.run_lmp(args, RESUME, "restart_resumed", variables={"fc_extra": ""})
     if not ck.ran(rest):
         return
     a = {int(r["Step"]): r for b in full.thermo for r in b}
