@@ -20,7 +20,7 @@ void LammpsDetection::init_walls(const std::vector<fibre::WallSpec> &walls)
 {
   walls_ = walls;
   for (int w = 0; w < static_cast<int>(walls.size()); ++w)
-    if (!walls[w].is_plane()) init_host_wall(w);
+    if (!walls[w].is_primitive()) init_host_wall(w);
 }
 
 // Whether the atoms are stored as at the last call: no neighbour build since (LAMMPS exchanges
@@ -162,7 +162,8 @@ void LammpsDetection::pair_contacts(const std::vector<fibre::Body> &bodies, doub
                                     double damping,
                                     std::vector<fibre::DetectedContact> &found) const
 {
-  NeighList *list = force->pair->list;
+  std::string style;
+  NeighList *list = fibre_lmp::granular_pair(lmp, style)->list;
   const int nlocal = atom->nlocal;
   const tagint *tag = atom->tag;
   double **x = atom->x, **v = atom->v, **omega = atom->omega;
@@ -251,6 +252,7 @@ void LammpsDetection::add_wall_contact(const std::vector<fibre::Body> &bodies, i
   fc.contact.wall_v = wall_v;
   fc.contact.wall_omega = wall_omega;
   fc.contact.wall_radius = wall_radius;
+  fc.contact.wall_type = walls_[wall].type;
   fc.store = exchange_.body_atom()[body];
   fc.tag_a = atom->tag[fc.store];
   fc.partner = fibre::wall_key(wall, sub);
@@ -275,6 +277,16 @@ void LammpsDetection::wall_contacts(const std::vector<fibre::Body> &bodies, doub
                            walls_[w].velocity(wall_time_), fibre::Vec3::Zero(), 0.0, h, damping,
                            found);
         }
+      }
+      continue;
+    }
+    if (walls_[w].is_cylinder()) {
+      // the curvature fix wall/gran gives a sphere inside a cylinder: -2 R
+      for (int k = 0; k < nowned; ++k) {
+        fibre::PlaneHit hit;
+        if (fibre::cylinder_hit(walls_[w], bodies[k], skin, hit))
+          add_wall_contact(bodies, k, hit.normal, hit.distance, w, 0, fibre::Vec3::Zero(),
+                           fibre::Vec3::Zero(), -2.0 * walls_[w].radius, h, damping, found);
       }
       continue;
     }

@@ -34,6 +34,8 @@
 #include "fibre/text.hpp"
 #include "fibre_output.h"
 #include "pair_coefficients.h"
+#include "deck_models.h"
+#include "wall_materials.h"
 #include "force.h"
 #include "group.h"
 #include "host.h"
@@ -135,13 +137,14 @@ FixFibreContact::FixFibreContact(LAMMPS *lmp, int narg, char **arg) : Fix(lmp, n
   atom->add_callback(fibre_lmp::kRestartCallback);
 
   // this fix computes every contact force: switch the pair style's forces off
-  if (force->pair) {
-    pair_ = force->pair;
+  std::string style;
+  if (Pair *gran = fibre_lmp::granular_pair(lmp, style)) {
+    pair_ = gran;
+    pair_owner_ = force->pair;
     pair_->compute_flag = 0;
     if (comm->me == 0)
-      logmesg(lmp, std::string("fix fibre_contact: switched off the force computation of "
-                               "pair style ") +
-                       force->pair_style + " (its neighbor list is the contact graph)\n");
+      logmesg(lmp, "fix fibre_contact: switched off the force computation of pair style " + style +
+                       " (its neighbor list is the contact graph)\n");
   }
 }
 
@@ -162,7 +165,7 @@ FixFibreContact::~FixFibreContact()
   delete[] extlist;
   atom->delete_callback(id, fibre_lmp::kGrowCallback);
   atom->delete_callback(id, fibre_lmp::kRestartCallback);
-  if (pair_ && force && force->pair == pair_) pair_->compute_flag = 1;
+  if (pair_ && force && force->pair == pair_owner_) pair_->compute_flag = 1;
 }
 
 /* ---------------------------------------------------------------------- */
@@ -238,14 +241,16 @@ void FixFibreContact::check_pair_style(bool at_init)
          "Fix fibre_contact requires a granular pair style for its "
          "neighbor list, e.g. 'pair_style gran/hooke 1.0 NULL 0.0 NULL "
          "0.0 0' and 'pair_coeff * *'");
-  const std::string style = force->pair_style ? force->pair_style : "";
-  if (!starts_with(style.c_str(), "gran"))
+  std::string style;
+  Pair *gran = fibre_lmp::granular_pair(lmp, style);
+  if (!gran)
     fail(error, FLERR,
          "Fix fibre_contact requires a granular pair style (gran/hooke, "
-         "gran/hooke/history, gran/hertz/history or granular) for its neighbor "
-         "list, not pair style '" +
+         "gran/hooke/history, gran/hertz/history or granular, alone or as the one granular "
+         "sub-style of pair_style hybrid or hybrid/overlay) for its neighbor list, not pair "
+         "style '" +
              style + "'");
-  if (at_init && force->pair->compute_flag)
+  if (at_init && gran->compute_flag)
     fail(error, FLERR,
          "Fix fibre_contact computes every contact force itself, but the "
          "pair style's force computation is on: define the pair style "
@@ -279,6 +284,7 @@ void FixFibreContact::read_coefficients()
   model.materials = reading.table;
   if (!model.typed.compliance) model.compliance.material = reading.material;
   if (comm->me != 0) return;
+  for (const std::string &text : reading.warnings) warn(error, FLERR, "Fix fibre_contact: " + text);
   bool frictionless = !model.typed.mu;
   for (int i = 1; i <= reading.table.ntypes(); ++i)
     for (int j = i; j <= reading.table.ntypes(); ++j)
@@ -290,7 +296,8 @@ void FixFibreContact::read_coefficients()
          "frictionless (give the fix's mu keyword, or "
          "'coefficients fix', to set it)");
   std::string text = "fix fibre_contact: coefficients from pair style " +
-                     std::string(force->pair_style) + " (types i j; walls take i i";
+                     std::string(force->pair_style) +
+                     " (types i j; walls take i i, or their own material";
   const fibre::TypedCoefficients &t = model.typed;
   if (t.mu || t.mu_roll || t.mu_twist || t.restitution)
     text += std::string("; overridden by the fix's") + (t.mu ? " mu" : "") +
@@ -383,12 +390,19 @@ void FixFibreContact::init()
 #endif
   check_pair_style(true);
   dtv_ = update->dt;
-  detection_->init_walls(settings_.walls);
   warn_double_integration();
+  fibre_lmp::warn_uncarried_fixes(lmp, id);
   warn_pair_computes();
   warn_short_damping();
   check_neighbor_updates();
   read_coefficients();
+  // the walls' own materials: types of the table (the deck's walls are not edited)
+  std::vector<fibre::WallSpec> walls = settings_.walls;
+  fibre::ContactModel &model = settings_.model;
+  const std::vector<int> types =
+      fibre_lmp::wall_material_types(lmp, walls, model.per_type() ? &model.materials : nullptr);
+  for (std::size_t k = 0; k < walls.size(); ++k) walls[k].type = types[k];
+  detection_->init_walls(walls);
   if (comm->me == 0) logmesg(lmp, "fix fibre_contact: " + fibre::describe(settings_) + "\n");
 }
 
@@ -399,7 +413,9 @@ void FixFibreContact::setup(int vflag)
   start_virial(vflag); // no contact forces before the run's first step: a zero virial
   first_step_ = true;
   detection_->start_moving_walls();
-  if (!force->pair || !force->pair->list)
+  std::string style;
+  const Pair *gran = fibre_lmp::granular_pair(lmp, style);
+  if (!gran || !gran->list)
     fail(error, FLERR, "Fix fibre_contact found no neighbor list of the pair style");
   dtv_ = update->dt;
 }
@@ -469,6 +485,24 @@ void FixFibreContact::smallest_body(const std::vector<fibre::Body> &bodies)
   if (std::isfinite(m[1])) r_min_ = m[1];
 }
 
+// Where the step is well below the longest that one substep allows (substep_collisions t_c):
+// that step, and the factor in steps it would save. The fix's cost is per step, nearly
+// independent of its length, so the factor is about its speed-up.
+std::string FixFibreContact::step_advice(double t_c) const
+{
+  const fibre::ContactModel &model = settings_.model;
+  const double longest = model.substep_collisions * t_c;
+  if (model.substeps > 0 || !(dtv_ < 0.5 * longest)) return "";
+  const auto g = [](double x) { return fibre::format_g(x); };
+  return ". This deck could take a step of up to " + g(longest) + " (one substep of " +
+         g(model.substep_collisions) + " t_c), " + g(longest / dtv_) +
+         " times this one, which takes that many times fewer steps: give 'timestep " + g(longest) +
+         "' (or a round step below it) and scale the deck's step counts (run, thermo, dump, "
+         "fix print, insertion every) by the same factor; fix move and wall wiggle follow time, "
+         "variables written in steps (step, elapsed) must be written in time, and LAMMPS's fix "
+         "pour keeps the interval in steps it took from the step in force when it was defined";
+}
+
 // The contact solve's substeps this step (fibre::substeps_for: automatic from the law's
 // shortest collision time for two spheres of the group's smallest radius and mass at 1 velocity
 // unit), alike on every process. Logged once per step size and count, with the step against
@@ -501,6 +535,7 @@ int FixFibreContact::step_substeps()
     text += ". Substeps longer than about a third of t_c let a collisional flow's contacts act "
             "as enduring ones, and its heaps and flows come out steeper and less mobile than the "
             "law's";
+  text += step_advice(shortest.t_c);
   logmesg(lmp, text + " (doc page, \"Time step and stiff materials\")\n");
   return n;
 }

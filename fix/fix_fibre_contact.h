@@ -79,6 +79,7 @@ class FixFibreContact : public Fix {
                   const std::vector<fibre::Contact> &contacts, double hs) const;
   void follow_substeps(const fibre::Vector &path, int n, double hs);
   int step_substeps();
+  std::string step_advice(double t_c) const;
   double simulated_time() const;
   void tally_wall_loads(const fibre::ContactSystem &sys,
                         const std::vector<fibre::DetectedContact> &found,
@@ -99,9 +100,10 @@ class FixFibreContact : public Fix {
   static constexpr double kDeepOverlap = 0.05; // of the smaller diameter: warned at a run's start
   double m_min_ = 0.0, r_min_ = 0.0;
   bool first_step_ = true;
-  double step_logged_ = 0.0;   // the step whose ratio to the collision time the log states
-  int substeps_logged_ = 0;    // and its substeps
-  class Pair *pair_ = nullptr; // pair style whose force computation this fix switched off
+  double step_logged_ = 0.0;         // the step whose ratio to the collision time the log states
+  int substeps_logged_ = 0;          // and its substeps
+  class Pair *pair_ = nullptr;       // pair style whose force computation this fix switched off
+  class Pair *pair_owner_ = nullptr; // the deck's pair style then (pair_ or its hybrid)
   std::unique_ptr<fibre_lmp::LammpsExchange> exchange_;
   std::unique_ptr<fibre_lmp::LammpsDetection> detection_;
   std::unique_ptr<fibre_lmp::FibreOutput> output_;

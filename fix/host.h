@@ -18,6 +18,8 @@
 
 #include "atom.h"
 #include "error.h"
+#include "force.h"
+#include "pair.h"
 #include "lammps.h"
 
 namespace fibre_lmp {
@@ -86,6 +88,24 @@ inline void logmesg(LAMMPS_NS::LAMMPS *lmp, const std::string &message)
 inline bool starts_with(const char *text, const char *prefix)
 {
   return text && std::string(text).rfind(prefix, 0) == 0;
+}
+
+// The granular pair style whose neighbour list is the contact graph and whose coefficients are
+// the material: the pair style itself (gran/* or granular), or the one granular sub-style of
+// pair_style hybrid or hybrid/overlay. nullptr if there is none; style: its name.
+inline LAMMPS_NS::Pair *granular_pair(LAMMPS_NS::LAMMPS *lmp, std::string &style)
+{
+  LAMMPS_NS::Force *force = lmp->force;
+  style = force->pair_style ? force->pair_style : "";
+  if (!force->pair) return nullptr;
+  if (starts_with(style.c_str(), "gran")) return force->pair;
+  if (!starts_with(style.c_str(), "hybrid")) return nullptr;
+  for (const char *name : {"granular", "gran/hertz/history", "gran/hooke/history", "gran/hooke"})
+    if (LAMMPS_NS::Pair *sub = force->pair_match(name, 1)) {
+      style = name;
+      return sub;
+    }
+  return nullptr;
 }
 
 } // namespace fibre_lmp

@@ -7,6 +7,7 @@
 #include "atom.h"
 #include "fibre/text.hpp"
 #include "force.h"
+#include "host.h"
 #include "lammps.h"
 #include "pair.h"
 
@@ -63,7 +64,7 @@ void read_granular(const std::string &bytes, int ntypes, PairReading &out)
 {
   Record rec(bytes);
   fibre::MaterialTable table(ntypes);
-  bool cohesion = false;
+  std::string cohesion; // the type pairs with dmt or jkr
   for (int i = 1; i <= ntypes; ++i)
     for (int j = i; j <= ntypes; ++j) {
       if (!rec.next_int()) continue; // setflag: mixed at init
@@ -90,11 +91,11 @@ void read_granular(const std::string &bytes, int ntypes, PairReading &out)
                                 : fibre::TwistLaw::none;
       p.twist_coeff = model[4] == 1 ? twist[2] : 0.0;
       p.limit_damping = model[5] != 0;
-      // elastic laws (compliance material); dmt's elastic part is hertz/material's, jkr's
-      // stored constants are not the Hertz ones
-      const fibre::NormalLaw laws[5] = {fibre::NormalLaw::hooke, fibre::NormalLaw::hertz,
-                                        fibre::NormalLaw::hertz_material,
-                                        fibre::NormalLaw::hertz_material, fibre::NormalLaw::none};
+      // elastic laws (compliance material); dmt's and jkr's elastic part is hertz/material's
+      // (LAMMPS stores 4/3 E_eff for all three)
+      const fibre::NormalLaw laws[5] = {
+          fibre::NormalLaw::hooke, fibre::NormalLaw::hertz, fibre::NormalLaw::hertz_material,
+          fibre::NormalLaw::hertz_material, fibre::NormalLaw::hertz_material};
       p.normal = laws[model[0]];
       p.k_n = normal[0];
       p.tangential = model[2] == 0   ? fibre::TangentialLaw::none
@@ -120,12 +121,15 @@ void read_granular(const std::string &bytes, int ntypes, PairReading &out)
         p.viscous = viscous[model[1]];
         p.viscous_coeff = normal[1];
       }
-      cohesion = cohesion || model[0] == kDmt || model[0] == kJkr;
+      if (model[0] == kDmt || model[0] == kJkr)
+        cohesion += (cohesion.empty() ? "" : ", ") + std::to_string(i) + " " + std::to_string(j) +
+                    (model[0] == kDmt ? " dmt" : " jkr");
       if (model[1] != kTsuji)
         out.notes.push_back("types " + std::to_string(i) + " " + std::to_string(j) + ": damping " +
                             kDamping[model[1]] +
-                            " has no single coefficient of restitution: the contacts are "
-                            "plastic unless the fix's restitution keyword is given");
+                            " has no single coefficient of restitution: each impact rebounds "
+                            "as the law's spring and dashpot give for its masses, radii and "
+                            "approach speed (unless the fix's restitution keyword is given)");
     }
   if (!rec.ok() || !rec.at_end()) {
     out.failure = "unexpected length of pair style granular's record (LAMMPS version layout)";
@@ -144,7 +148,11 @@ void read_granular(const std::string &bytes, int ntypes, PairReading &out)
                       "by implicit Euler; the tangential rows take the normal law's or its "
                       "critical damping, whichever is longer; bounces take e); the tangential "
                       "damping coefficient is not used");
-  if (cohesion) out.notes.push_back("the cohesion of dmt and jkr is not modelled");
+  if (!cohesion.empty())
+    out.warnings.push_back("the cohesion of pair_coeff's dmt and jkr is not modelled (types " +
+                           cohesion +
+                           "): those contacts take their Hertz law only, without pull-off; keep "
+                           "such a deck native, or accept cohesionless grains");
   out.table = std::move(table);
   out.material = true;
 }
@@ -177,6 +185,12 @@ void read_gran(const std::string &style, const std::string &bytes, int ntypes, P
                      : hertz  ? fibre::TangentialLaw::mindlin
                               : fibre::TangentialLaw::linear;
       p.k_t = kt;
+      // the dashpot m_eff gamman (hooke), m_eff gamman a (hertz): compliance material's
+      if (gamman > 0) {
+        p.viscous =
+            hertz ? fibre::ViscousDamping::viscoelastic : fibre::ViscousDamping::mass_velocity;
+        p.viscous_coeff = gamman;
+      }
     }
   out.notes.push_back("pair style " + style + ": mu = xmu " + fibre::format_g(xmu) + "; kn " +
                       fibre::format_g(kn) + ", kt " + fibre::format_g(kt) +
@@ -184,18 +198,189 @@ void read_gran(const std::string &style, const std::string &bytes, int ntypes, P
                       "auto', rigid rows: kn = 1 is the common neighbour-list-only setting), and "
                       "its damping gamman " +
                       fibre::format_g(gamman) +
-                      " is viscous, without a single coefficient of restitution: the contacts "
-                      "are plastic unless the fix's restitution keyword is given");
+                      " is viscous, without a single coefficient of restitution: under "
+                      "'compliance material' each impact rebounds as the law's spring and "
+                      "dashpot give for its masses, radii and approach speed; otherwise the "
+                      "contacts are plastic unless the fix's restitution keyword is given");
   out.table = std::move(table);
+}
+
+// Reads words[k], words[k+1], ... as numbers; false at the first that is missing or not one.
+bool numbers(const std::vector<std::string> &words, std::size_t k, std::size_t n, double *out)
+{
+  for (std::size_t m = 0; m < n; ++m)
+    if (k + m >= words.size() || !fibre::to_double(words[k + m], out[m])) return false;
+  return true;
+}
+
+// fix wall/gran's hooke, hooke/history and hertz/history: kn kt gamman gammat xmu dampflag
+// (kt NULL: 2/7 kn); gamman is a viscous dashpot, m gamman (hooke) or m gamman a (hertz).
+void read_wall_gran(const std::vector<std::string> &words, WallReading &out)
+{
+  const std::string &style = words[0];
+  const bool hertz = style == "hertz/history";
+  double v[6] = {0, 0, 0, 0, 0, 0};
+  const bool kt_null = words.size() > 2 && words[2] == "NULL";
+  std::vector<std::string> w = words;
+  if (kt_null) w[2] = "0";
+  if (w.size() > 4 && w[4] == "NULL") w[4] = "0";
+  if (w.size() != 7 || !numbers(w, 1, 6, v) || v[0] < 0 || v[1] < 0 || v[2] < 0 || v[4] < 0) {
+    out.failure = "expected '" + style + " <kn> <kt|NULL> <gamman> <gammat|NULL> <xmu> <dampflag>'";
+    return;
+  }
+  fibre::PairCoefficients &p = out.coefficients;
+  p.set = true;
+  p.normal = hertz ? fibre::NormalLaw::hertz : fibre::NormalLaw::hooke;
+  p.k_n = v[0];
+  p.tangential = style == "hooke" ? fibre::TangentialLaw::none
+                 : hertz          ? fibre::TangentialLaw::mindlin
+                                  : fibre::TangentialLaw::linear;
+  p.k_t = kt_null ? v[0] * 2.0 / 7.0 : v[1];
+  p.viscous = hertz ? fibre::ViscousDamping::viscoelastic : fibre::ViscousDamping::mass_velocity;
+  p.viscous_coeff = v[2];
+  p.mu = v[4];
+}
+
+// One model of fix wall/gran granular at words[k] (hooke, hertz, hertz/material, dmt, jkr,
+// damping, tangential, rolling, twisting); returns the words read, 0 on a failure.
+std::size_t read_granular_model(const std::vector<std::string> &words, std::size_t k,
+                                WallReading &out, double &e_mod, double &nu, double &damp,
+                                int &damping)
+{
+  fibre::PairCoefficients &p = out.coefficients;
+  const std::string &m = words[k];
+  const std::string next = k + 1 < words.size() ? words[k + 1] : "";
+  double v[4] = {0, 0, 0, 0};
+  if (m == "hooke" || m == "hertz") {
+    if (!numbers(words, k + 1, 2, v)) return 0;
+    p.normal = m == "hooke" ? fibre::NormalLaw::hooke : fibre::NormalLaw::hertz;
+    p.k_n = v[0];
+    damp = v[1];
+    return 3;
+  }
+  if (m == "hertz/material" || m == "dmt" || m == "jkr") {
+    const std::size_t n = m == "hertz/material" ? 3 : 4;
+    if (!numbers(words, k + 1, n, v)) return 0;
+    e_mod = v[0];
+    damp = v[1];
+    nu = v[2];
+    // fix wall/gran's wall constant (not the pair's 4/3 E / (2 (1 - nu^2)))
+    p.normal = fibre::NormalLaw::hertz_material;
+    p.k_n = 4.0 / 3.0 * e_mod / (2.0 * (1.0 - nu));
+    if (n == 4)
+      out.warnings.push_back("the wall's " + m + " cohesion (" + fibre::format_g(v[3]) +
+                             ") is not modelled: the wall takes its Hertz law only");
+    return n + 1;
+  }
+  if (m == "damping") {
+    const char *const models[] = {"velocity", "mass_velocity", "viscoelastic", "tsuji"};
+    for (int d = 0; d < 4; ++d)
+      if (next == models[d]) damping = d;
+    return damping >= 0 && next == models[damping] ? 2 : 0;
+  }
+  if (m == "tangential") {
+    if (next == "linear_nohistory") {
+      if (!numbers(words, k + 2, 2, v)) return 0;
+      p.tangential = fibre::TangentialLaw::none;
+      p.mu = v[1];
+      return 4;
+    }
+    if (next != "linear_history" && next != "mindlin" && next != "mindlin_rescale") return 0;
+    const bool null = k + 2 < words.size() && words[k + 2] == "NULL" && next != "linear_history";
+    if (!numbers(words, k + 3, 2, v + 1) || (!null && !numbers(words, k + 2, 1, v))) return 0;
+    if (null && e_mod <= 0) {
+      out.failure = "'tangential " + next + " NULL' needs hertz/material, dmt or jkr before it";
+      return 0;
+    }
+    p.tangential =
+        next == "linear_history" ? fibre::TangentialLaw::linear : fibre::TangentialLaw::mindlin;
+    p.k_t = null ? e_mod / 4.0 * (2.0 - nu) * (1.0 + nu) : v[0]; // fix wall/gran's constant
+    p.mu = v[2];
+    return 5;
+  }
+  if ((m == "rolling" || m == "twisting") && next == "none") return 2;
+  if (m == "twisting" && next == "marshall") {
+    p.twist = fibre::TwistLaw::marshall;
+    return 2;
+  }
+  if ((m == "rolling" || m == "twisting") && next == "sds") {
+    if (!numbers(words, k + 2, 3, v)) return 0;
+    if (m == "rolling") {
+      p.k_roll = v[0];
+      p.gamma_roll = v[1];
+      p.mu_roll = v[2];
+    } else {
+      p.twist = fibre::TwistLaw::sds;
+      p.k_twist = v[0];
+      p.gamma_twist = v[1];
+      p.twist_coeff = v[2];
+    }
+    return 5;
+  }
+  return 0;
+}
+
+void read_wall_granular(const std::vector<std::string> &words, WallReading &out)
+{
+  double e_mod = 0.0, nu = 0.0, damp = 0.0;
+  int damping = 2; // viscoelastic, fix wall/gran's default
+  std::size_t k = 1;
+  while (k < words.size()) {
+    const std::size_t used = read_granular_model(words, k, out, e_mod, nu, damp, damping);
+    if (used == 0) {
+      if (out.failure.empty())
+        out.failure = "cannot read '" + words[k] +
+                      "' and its arguments as fix wall/gran granular's (hooke, hertz, "
+                      "hertz/material, dmt, jkr, damping, tangential, rolling, twisting)";
+      return;
+    }
+    k += used;
+  }
+  fibre::PairCoefficients &p = out.coefficients;
+  if (p.normal == fibre::NormalLaw::none) {
+    out.failure = "'granular' needs a normal model (hooke, hertz, hertz/material, dmt or jkr)";
+    return;
+  }
+  p.set = true;
+  if (damping == kTsuji) {
+    p.damping_alpha = fibre::tsuji_damping(damp);
+    p.restitution = fibre::rebound_restitution(
+        p.normal == fibre::NormalLaw::hooke ? fibre::NormalLaw::hooke : fibre::NormalLaw::hertz,
+        p.damping_alpha);
+  } else {
+    const fibre::ViscousDamping viscous[3] = {fibre::ViscousDamping::velocity,
+                                              fibre::ViscousDamping::mass_velocity,
+                                              fibre::ViscousDamping::viscoelastic};
+    p.viscous = viscous[damping];
+    p.viscous_coeff = damp;
+  }
 }
 
 } // namespace
 
+WallReading read_wall_interaction(const std::vector<std::string> &words)
+{
+  WallReading out;
+  const std::string style = words.empty() ? "" : words[0];
+  if (style == "granular")
+    read_wall_granular(words, out);
+  else if (style == "hooke" || style == "hooke/history" || style == "hertz/history")
+    read_wall_gran(words, out);
+  else
+    out.failure = "expected fix wall/gran's interaction: granular, hooke, hooke/history or "
+                  "hertz/history";
+  if (out.failure.empty() && out.coefficients.restitution < 0)
+    out.notes.push_back("the wall's viscous damping has no single coefficient of restitution: "
+                        "each impact rebounds as the law's spring and dashpot give for the "
+                        "sphere's mass, radius and approach speed");
+  return out;
+}
+
 PairReading read_pair_coefficients(LAMMPS_NS::LAMMPS *lmp)
 {
   PairReading out;
-  LAMMPS_NS::Pair *pair = lmp->force->pair;
-  const std::string style = lmp->force->pair_style ? lmp->force->pair_style : "";
+  std::string style;
+  LAMMPS_NS::Pair *pair = granular_pair(lmp, style);
   const int ntypes = lmp->atom->ntypes;
   if (!pair || ntypes < 1) {
     out.failure = "no pair style";

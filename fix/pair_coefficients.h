@@ -23,7 +23,9 @@ namespace fibre_lmp {
 struct PairReading {
   fibre::MaterialTable table;     // empty when the style gave nothing usable
   std::vector<std::string> notes; // what the fix does not use, one line each
-  std::string failure;            // why nothing could be read ("" if it could)
+  // the deck's models that the fix does not carry (cohesion, wear, ...): a WARNING each
+  std::vector<std::string> warnings;
+  std::string failure;   // why nothing could be read ("" if it could)
   bool required = false; // the host defines its material here (LIGGGHTS): a failure is an error
   // The style's stiffnesses describe a material, so that 'compliance material' is the default:
   // pair granular and LIGGGHTS's material properties, not the gran/* styles, whose kn = 1 is
@@ -32,6 +34,17 @@ struct PairReading {
 };
 
 PairReading read_pair_coefficients(LAMMPS_NS::LAMMPS *lmp);
+
+// The coefficients of a wall from the interaction words of the fix wall/gran (or
+// wall/gran/region) it replaces, as that fix turns them into its law ("granular hertz/material
+// E e nu tangential ...", "hooke/history kn kt gamman gammat xmu dampflag"): LAMMPS 29 Sep
+// 2021's constants. `failure` says why they cannot be read ("" if they can); notes as above.
+struct WallReading {
+  fibre::PairCoefficients coefficients;
+  std::vector<std::string> notes, warnings;
+  std::string failure;
+};
+WallReading read_wall_interaction(const std::vector<std::string> &words);
 
 } // namespace fibre_lmp
 

@@ -6,7 +6,9 @@
 #include <cstring>
 #include <memory>
 
+#include "comm.h"
 #include "domain.h"
+#include "fibre/text.hpp"
 #include "error.h"
 #include "fibre_detect.h"
 #include "host.h"
@@ -52,6 +54,31 @@ Region *contact_owner(Domain *domain, Region *region, int iwall)
   return region;
 }
 
+// LAMMPS's Region::set_velocity multiplies the angular speed by the rotation axis as typed
+// (omega = dtheta/dt axis), so a region rotating about '1 1 1' would spin its wall sqrt(3) times
+// too fast; the fix divides by |axis|. Region::axis is private: an explicit instantiation may
+// name it (access checks do not apply to the names in one, C++17 [temp.explicit]/14).
+using AxisMember = double (Region::*)[3];
+AxisMember region_axis();
+template <AxisMember M> struct ExposeAxis {
+  friend AxisMember region_axis() { return M; }
+};
+template struct ExposeAxis<&Region::axis>;
+
+double axis_length(const Region *region)
+{
+  const double *a = region->*region_axis();
+  return std::sqrt(a[0] * a[0] + a[1] * a[1] + a[2] * a[2]);
+}
+
+// A rotating (sub-)region's angular velocity about its unit axis.
+fibre::Vec3 angular_velocity(const Region *region)
+{
+  const double len = axis_length(region);
+  const fibre::Vec3 w(region->omega[0], region->omega[1], region->omega[2]);
+  return len > 0.0 ? fibre::Vec3(w / len) : w;
+}
+
 // A moving (sub-)region's surface velocity at point p and its angular velocity, from its
 // displacement and rotation over the last step (set_velocity, LAMMPS's differencing).
 void surface_velocity(const Region *region, const double *p, fibre::Vec3 &v, fibre::Vec3 &w)
@@ -60,7 +87,7 @@ void surface_velocity(const Region *region, const double *p, fibre::Vec3 &v, fib
                        : fibre::Vec3::Zero();
   w = fibre::Vec3::Zero();
   if (!region->rotateflag) return;
-  w = fibre::Vec3(region->omega[0], region->omega[1], region->omega[2]);
+  w = angular_velocity(region);
   const fibre::Vec3 arm(p[0] - region->rpoint[0], p[1] - region->rpoint[1],
                         p[2] - region->rpoint[2]);
   v += w.cross(arm);
@@ -82,14 +109,31 @@ double speed_bound(Domain *domain, const Region *region, const double *x, double
                                  region->v[2] * region->v[2])
                      : 0.0;
   if (region->rotateflag) {
-    const double w =
-        std::sqrt(region->omega[0] * region->omega[0] + region->omega[1] * region->omega[1] +
-                  region->omega[2] * region->omega[2]);
+    const double w = angular_velocity(region).norm();
     const double dx = x[0] - region->rpoint[0], dy = x[1] - region->rpoint[1],
                  dz = x[2] - region->rpoint[2];
     speed += w * (std::sqrt(dx * dx + dy * dy + dz * dz) + radius);
   }
   return speed;
+}
+
+// A rotation axis that is not a unit vector: LAMMPS's fix wall/gran/region then moves the wall
+// |axis| times too fast; this fix uses the unit axis.
+void warn_axis(Domain *domain, Error *error, bool me0, const Region *region)
+{
+  if (is_combined(region)) {
+    for (int i = 0; i < region->nregion; ++i)
+      warn_axis(domain, error, me0, domain->regions[region->list[i]]);
+    return;
+  }
+  const double len = region->rotateflag ? axis_length(region) : 1.0;
+  if (me0 && std::abs(len - 1.0) > 1e-6)
+    warn(error, FLERR,
+         "Fix fibre_contact 'wall region': region " + std::string(region->id) +
+             " rotates about an axis of length " + fibre::format_g(len) +
+             "; LAMMPS's region velocity (and fix wall/gran/region's wall speed) is then that "
+             "many times the angular speed, the fix uses the unit axis (type the axis as a "
+             "unit vector for a native twin to agree)");
 }
 
 } // namespace
@@ -134,6 +178,7 @@ void LammpsDetection::init_host_wall(int w)
                  "supported; list its sub-regions in " +
                  id + " instead");
     }
+  warn_axis(domain, error, comm->me == 0, region);
   if (region->varshape)
     fail(error, FLERR,
          "Fix fibre_contact 'wall region " + id +

@@ -91,6 +91,11 @@ PairReading read_pair_coefficients(LAMMPS_NS::LAMMPS *lmp)
                   std::to_string(ntypes) + " ...'";
     return out;
   }
+  for (const char *model : {"sjkr", "sjkr2", "easo/capillary/viscous", "washino/capillary/viscous"})
+    if (matches(pair, "cohesion", model))
+      out.warnings.push_back(std::string("pair style gran's 'cohesion ") + model +
+                             "' is not modelled: the contacts have no cohesion (keep such a "
+                             "deck native, or accept cohesionless grains)");
   if (!hertz)
     out.notes.push_back("the normal model is not hertz: compliance material has no elastic "
                         "constants here (LIGGGHTS's hooke stiffness depends on each contact's "
@@ -126,6 +131,22 @@ PairReading read_pair_coefficients(LAMMPS_NS::LAMMPS *lmp)
     }
   out.table = std::move(table);
   out.material = hertz && young && poisson;
+  return out;
+}
+
+} // namespace fibre_lmp
+
+namespace fibre_lmp {
+
+// LIGGGHTS walls take a type's material (fix wall/gran's `primitive type T`, a mesh's type):
+// fix wall/gran's LAMMPS interaction words are LAMMPS's.
+WallReading read_wall_interaction(const std::vector<std::string> &words)
+{
+  WallReading out;
+  out.failure = "'" + (words.empty() ? std::string() : words[0]) +
+                "' is LAMMPS's fix wall/gran interaction; a LIGGGHTS wall takes the material of "
+                "an atom type from fix property/global: 'wall type <T> ...' (as fix wall/gran's "
+                "'primitive type T')";
   return out;
 }
 

@@ -73,6 +73,13 @@ void apply_pair(const ContactModel &model, const PairCoefficients &pc, const Spo
   if (!typed.mu_twist) c.friction.mu_twist = f.mu_twist;
   if (!typed.restitution && pc.restitution >= 0) c.restitution = pc.restitution;
   if (!model.compliance.material) return;
+  // a viscous dashpot's rebound depends on the impact: its masses, radii and approach speed
+  // (the law's; under compliance auto the gran/* styles' kn is no material)
+  if (!typed.restitution && pc.restitution < 0 && last_normal == 0) {
+    const double e =
+        viscous_restitution(pc, effective_mass(bodies, c), reff, normal_approach(bodies, c));
+    if (e >= 0) c.restitution = e;
+  }
   const int rows = model.rows;
   const double force = last_normal / h;
   const std::array<double, kMaxRows> rigid = c.compliance;
@@ -180,7 +187,8 @@ bool ContactModel::may_bounce() const
   if (!per_type() || typed.restitution) return false;
   for (int i = 1; i <= materials.ntypes(); ++i)
     for (int j = i; j <= materials.ntypes(); ++j)
-      if (materials.at(i, j).restitution > 0) return true;
+      if (materials.at(i, j).restitution > 0 || materials.at(i, j).viscous != ViscousDamping::none)
+        return true;
   return false;
 }
 

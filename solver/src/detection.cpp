@@ -72,6 +72,19 @@ int plane_hits(const WallSpec &wall, const Body &b, double reach, PlaneHit hits[
   return n;
 }
 
+int cylinder_hit(const WallSpec &wall, const Body &b, double reach, PlaneHit &hit)
+{
+  const int a = wall.axis(), i = (a + 1) % 3, j = (a + 2) % 3;
+  const double dx = b.x[i] - wall.centre[0], dy = b.x[j] - wall.centre[1];
+  const double rho = std::sqrt(dx * dx + dy * dy);
+  const double distance = wall.radius - rho;
+  if (!(rho > 0.0) || !(distance - b.radius < reach)) return 0;
+  hit = PlaneHit{Vec3::Zero(), distance, 0};
+  hit.normal[i] = -dx / rho;
+  hit.normal[j] = -dy / rho;
+  return 1;
+}
+
 void sort_contacts(std::vector<DetectedContact> &found)
 {
   // Sort compact keys, then move each contact once: a Contact is a few hundred bytes, so

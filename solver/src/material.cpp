@@ -1,6 +1,8 @@
 #include "fibre/material.hpp"
 
 #include <algorithm>
+#include <array>
+#include <vector>
 #include <cmath>
 
 #include "fibre/text.hpp"
@@ -22,6 +24,16 @@ const PairCoefficients &MaterialTable::at(int i, int j) const
 {
   if (i > j) std::swap(i, j);
   return pairs_[std::size_t(i - 1) * std::size_t(ntypes_) + std::size_t(j - 1)];
+}
+
+int MaterialTable::add_type(const PairCoefficients &p)
+{
+  MaterialTable grown(ntypes_ + 1);
+  for (int i = 1; i <= ntypes_; ++i)
+    for (int j = i; j <= ntypes_; ++j) grown.at(i, j) = at(i, j);
+  for (int i = 1; i <= ntypes_ + 1; ++i) grown.at(i, ntypes_ + 1) = p;
+  *this = std::move(grown);
+  return ntypes_;
 }
 
 std::string MaterialTable::mix()
@@ -98,18 +110,29 @@ double restitution_from_tsuji(double alpha)
   return 0.5 * (lo + hi);
 }
 
-double rebound_restitution(NormalLaw law, double alpha, bool limit_damping)
+namespace {
+
+// The rebound of X'' = -X^p - beta X^q X' from X = 0 at X' = 1 (a damped normal law in units of
+// its deepest overlap and approach speed), by RK4 until the overlap closes, or with
+// limit_damping until the force vanishes; 0 where it never closes (overdamped).
+// The powers are 1 or 3/2 and 0, 1/4 or 1/2. After max_steps steps of dt an overlap still open
+// counts as overdamped.
+double rebound(double p, double q, double beta, bool limit_damping, int max_steps = 1000000,
+               double dt = 1e-4)
 {
-  if (!(alpha >= 0)) return 0.0;
-  const bool hooke = law == NormalLaw::hooke;
-  // d'' = -F(d, d') with m = k = 1, from d = 0 at approach speed 1
+  const auto power = [](double x, double e) {
+    return e == 0     ? 1.0
+           : e == 1   ? x
+           : e == 1.5 ? x * std::sqrt(x)
+           : e == 0.5 ? std::sqrt(x)
+                      : std::sqrt(std::sqrt(x));
+  };
   const auto force = [&](double d, double v) {
     const double x = std::max(d, 0.0);
-    const double f = hooke ? x + alpha * v : x * std::sqrt(x) + alpha * std::sqrt(std::sqrt(x)) * v;
+    const double f = power(x, p) + beta * power(x, q) * v;
     return limit_damping ? std::max(f, 0.0) : f;
   };
-  constexpr double dt = 1e-4; // a collision lasts about 3.2 (hertz), pi (hooke)
-  constexpr int max_steps = 1000000;
+  // dt: a collision lasts about 3.2 (hertz), pi (hooke)
   double d = 0.0, v = 1.0;
   for (int k = 0; k < max_steps; ++k) {
     const double k1d = v, k1v = -force(d, v);
@@ -128,6 +151,63 @@ double rebound_restitution(NormalLaw law, double alpha, bool limit_damping)
     v = v_next;
   }
   return 0.0; // overdamped: the overlap never closes
+}
+
+// rebound(p, q, beta) on a log grid of beta, integrated once per law on first use: beta from
+// 1e-4 (e within 1e-4 of 1) to 1e3 (overdamped), kTablePoints per decade.
+constexpr double kBetaLo = -4.0, kBetaHi = 3.0;
+constexpr int kTablePoints = 48;
+constexpr double kTableDt = 2.5e-4;
+constexpr int kTableSteps = 40000; // 10 units: three collision times
+
+double tabulated_rebound(int law, double p, double q, bool limit_damping, double beta)
+{
+  static std::array<std::vector<double>, 8> tables;
+  std::vector<double> &table = tables[std::size_t(law)];
+  const int n = static_cast<int>((kBetaHi - kBetaLo) * kTablePoints);
+  if (table.empty())
+    for (int k = 0; k <= n; ++k)
+      table.push_back(rebound(p, q, std::pow(10.0, kBetaLo + double(k) / kTablePoints),
+                              limit_damping, kTableSteps, kTableDt));
+  if (!(beta > 0)) return 1.0;
+  const double at = (std::log10(beta) - kBetaLo) * kTablePoints;
+  if (at <= 0) return 1.0 - (1.0 - table[0]) * beta / std::pow(10.0, kBetaLo);
+  if (at >= n) return table[std::size_t(n)];
+  const int k = static_cast<int>(at);
+  const double f = at - k;
+  return (1.0 - f) * table[std::size_t(k)] + f * table[std::size_t(k) + 1];
+}
+
+} // namespace
+
+double rebound_restitution(NormalLaw law, double alpha, bool limit_damping)
+{
+  if (!(alpha >= 0)) return 0.0;
+  // hooke F = k d + alpha sqrt(m k) d'; hertz F = k a d + alpha sqrt(m k a) d', a = sqrt(r d)
+  return law == NormalLaw::hooke ? rebound(1.0, 0.0, alpha, limit_damping)
+                                 : rebound(1.5, 0.25, alpha, limit_damping);
+}
+
+double viscous_restitution(const PairCoefficients &p, double m_eff, double r_eff, double v)
+{
+  if (p.viscous == ViscousDamping::none || p.normal == NormalLaw::none || !(m_eff > 0) ||
+      !(v > 0) || !(p.k_n > 0))
+    return -1.0;
+  // m d'' = -K d^pw - g d^q d': hooke K = k_n; hertz K = k_n sqrt(r_eff); the dashpot g is c,
+  // c m_eff or c m_eff sqrt(r_eff) d^1/2 (normal_damper). In units of x0 = (m v^2 / K)^(1 /
+  // (pw + 1)) and x0 / v it is X'' = -X^pw - beta X^q X' with beta = g x0^(q + 1) / (m v).
+  const bool hooke = p.normal == NormalLaw::hooke;
+  const double pw = hooke ? 1.0 : 1.5;
+  const double stiffness = hooke ? p.k_n : p.k_n * std::sqrt(r_eff);
+  const bool visco = p.viscous == ViscousDamping::viscoelastic;
+  const double q = visco ? 0.5 : 0.0;
+  double g = p.viscous_coeff;
+  if (p.viscous != ViscousDamping::velocity) g *= m_eff;
+  if (visco) g *= std::sqrt(r_eff);
+  const double x0 = std::pow(m_eff * v * v / stiffness, 1.0 / (pw + 1.0));
+  const double beta = g * std::pow(x0, q + 1.0) / (m_eff * v);
+  const int law = (hooke ? 0 : 4) + (visco ? 2 : 0) + (p.limit_damping ? 1 : 0);
+  return tabulated_rebound(law, pw, q, p.limit_damping, beta);
 }
 
 FrictionParams contact_friction(const PairCoefficients &p, double r_eff, double overlap)

@@ -91,16 +91,66 @@ std::size_t read_plane_motion(const Reader &in, std::size_t i, WallSpec &w)
   return 3;
 }
 
-// "wall xplane|yplane|zplane <lo|NULL> <hi|NULL>", "wall region <region-ID>" or
-// "wall mesh <fix-ID>" at args[i]; returns the number of words read.
+// "wall <material> x|y|zcylinder <radius> [<c1> <c2>]" from args[i] ("wall"): the grains are
+// inside; the axis passes through c1 c2 in the other coordinates (0 0 if not given, as fix
+// wall/gran's zcylinder; LIGGGHTS's primitive gives them).
+std::size_t read_cylinder(const Reader &in, std::size_t i, WallSpec &w)
+{
+  const std::string kind = in.at(i + 1);
+  const std::string e = "'wall " + kind + " <radius> [<c1> <c2>]' (radius > 0)";
+  w.radius = in.positive(i + 2, e);
+  std::size_t used = 3;
+  double c[2] = {0.0, 0.0};
+  if (in.has(i + 4) && to_double(in.at(i + 3), c[0]) && to_double(in.at(i + 4), c[1])) {
+    w.centre[0] = c[0];
+    w.centre[1] = c[1];
+    used = 5;
+  }
+  if (in.has(i + used) && (in.at(i + used) == "wiggle" || in.at(i + used) == "shear"))
+    Reader::illegal(e + " without motion (a cylinder wall stands still)", &in.at(i + used));
+  return used;
+}
+
+// The wall's material before its style: "type <T>" or the interaction words of fix wall/gran
+// (granular, hooke, hooke/history or hertz/history and their arguments, up to the style).
+// Returns the words read.
+std::size_t read_wall_material(const Reader &in, std::size_t i, WallSpec &w)
+{
+  if (!in.has(i)) return 0;
+  const std::string &first = in.at(i);
+  if (first == "type") {
+    w.type = static_cast<int>(
+        in.integer(i + 1, "'wall type <T> <style> ...' (T an atom type)", 1, 1000000));
+    return 2;
+  }
+  if (first != "granular" && first != "hooke" && first != "hooke/history" &&
+      first != "hertz/history")
+    return 0;
+  std::size_t k = i;
+  WallKind kind{};
+  while (in.has(k) && !parse(in.at(k), kind)) w.model.push_back(in.at(k++));
+  if (!in.has(k))
+    Reader::illegal("'wall " + first +
+                    " <coefficients> xplane|yplane|zplane|zcylinder|region ...' (fix "
+                    "wall/gran's "
+                    "interaction and arguments, then the wall's style)");
+  return k - i;
+}
+
+// "wall [type T | <fix wall/gran interaction>] xplane|yplane|zplane <lo|NULL> <hi|NULL>",
+// "... region <region-ID>" or "... mesh <fix-ID>" at args[i]; returns the number of words read.
 std::size_t read_wall(const Reader &in, std::size_t i, WallSpec &w)
 {
   const std::string e =
-      "'wall xplane|yplane|zplane <lo|NULL> <hi|NULL>', 'wall region <region-ID>' or 'wall mesh "
-      "<fix-ID>'";
+      "'wall xplane|yplane|zplane <lo|NULL> <hi|NULL>', 'wall xcylinder|ycylinder|zcylinder "
+      "<radius> [<c1> <c2>]', 'wall region <region-ID>' or 'wall mesh <fix-ID>' (optionally "
+      "'type <T>' or fix wall/gran's interaction after 'wall')";
+  const std::size_t material = read_wall_material(in, i + 1, w);
+  if (material > 0) return material + read_wall(in, i + material, w);
   if (!in.has(i + 1)) Reader::illegal(e);
   const std::string &kind = in.at(i + 1);
   if (!parse(kind, w.kind)) Reader::illegal(e, &kind);
+  if (w.is_cylinder()) return read_cylinder(in, i, w);
   if (!w.is_plane()) {
     const std::string ek = w.kind == WallKind::region ? "'wall region <region-ID>'"
                                                       : "'wall mesh <fix-ID>' (a fix mesh/surface)";

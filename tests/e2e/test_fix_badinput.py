@@ -81,7 +81,19 @@ CASES = [
     ("active_set_zero", "active_set 0", "expected 'active_set <positive integer>', got '0'",
      {}),
     ("wall_kind", "wall cylinder 1 2", "'wall xplane|yplane|zplane <lo|NULL> <hi|NULL>', "
-     "'wall region <region-ID>' or 'wall mesh <fix-ID>', got 'cylinder'", {}),
+     "'wall xcylinder|ycylinder|zcylinder <radius> [<c1> <c2>]', 'wall region <region-ID>' or "
+     "'wall mesh <fix-ID>' (optionally 'type <T>' or fix wall/gran's interaction after 'wall'), "
+     "got 'cylinder'", {}),
+    ("wall_cylinder_radius", "wall zcylinder -1", "expected 'wall zcylinder <radius> [<c1> <c2>]' "
+     "(radius > 0), got '-1'", {}),
+    ("wall_type_range", "wall type 9 zplane 0 NULL", "'wall type 9 zplane ...': type 9 is not an "
+     "atom type (1 to 1)", {}),
+    ("wall_interaction", "wall granular hertz/material 1e5 0.3 zplane 0 NULL",
+     "cannot read 'hertz/material' and its arguments as fix wall/gran granular's", {}),
+    ("wall_interaction_null", "wall granular hertz 1e5 0.3 tangential mindlin NULL 1.0 0.5 zplane "
+     "0 NULL", "'tangential mindlin NULL' needs hertz/material, dmt or jkr before it", {}),
+    ("wall_interaction_gran", "wall hooke 1e5 NULL zplane 0 NULL", "expected 'hooke <kn> <kt|NULL> "
+     "<gamman> <gammat|NULL> <xmu> <dampflag>'", {}),
     ("wall_mesh_lammps", "wall mesh cad", "mesh walls (fix mesh/surface) need the LIGGGHTS front "
      "end", {}),
     ("wall_plane_missing", "wall zplane 0.0", "expected 'wall zplane <lo|NULL> <hi|NULL>'",
@@ -143,6 +155,16 @@ WARN_CASES = [
     ("pair_local", "", "compute pl (pair/local) reads the pair style, whose forces are switched "
      "off", {"post": "compute pl all pair/local dist"}),
     ("short_damping", "damping 0.5", "Fix fibre_contact: damping 0.5 is below 2 steps", {}),
+    ("wall_gran_kept", "wall zplane 0 NULL", "fix w (wall/gran) computes wall forces of its own",
+     {"post": "fix w all wall/gran hooke 2000 NULL 50 NULL 0.5 0 zplane 0 NULL"}),
+    ("jkr_cohesion", "", "the cohesion of pair_coeff's dmt and jkr is not modelled (types 1 1 "
+     "jkr)", {"pair": "pair_style granular\npair_coeff * * jkr 1000.0 50.0 0.3 10 tangential "
+              "mindlin 800.0 1.0 0.5"}),
+    ("wall_cohesion", "wall granular dmt 1e5 0.3 0.3 5 tangential linear_history 100 1 0.5 "
+     "zplane 0 NULL", "the wall's dmt cohesion (5) is not modelled", {}),
+    ("rotation_axis", "wall region cup", "region cup rotates about an axis of length 1.41421",
+     {"pre": "variable th equal 0.1*time\nregion cup block -2 2 -2 2 0 5 side in units box "
+             "rotate v_th 0 0 0 1 1 0"}),
 ]
 
 

@@ -210,8 +210,36 @@ TEST(Detection, WallNames)
   EXPECT_TRUE(parse("mesh", k));
   EXPECT_EQ(k, WallKind::mesh);
   EXPECT_FALSE(parse("cylinder", k));
-  EXPECT_EQ(choices<WallKind>(), "xplane|yplane|zplane|region|mesh");
+  EXPECT_EQ(choices<WallKind>(), "xplane|yplane|zplane|region|mesh|xcylinder|ycylinder|zcylinder");
   EXPECT_LT(mesh_key(0, 0), wall_key(1023, kWallKeyStride - 1));
   EXPECT_NE(mesh_key(0, 1), mesh_key(1, 0));
   EXPECT_EQ(mesh_key(2, 123456789), -(kMeshKeyBase + 123456789.0 * kWallKeyStride + 3));
+}
+
+// A cylinder wall holds the spheres inside it: the normal points to the axis, the distance is
+// from the surface to the centre; beyond reach, or on the axis, no contact.
+TEST(Detection, CylinderWallHoldsTheSpheresInside)
+{
+  WallSpec w;
+  w.kind = WallKind::ycylinder; // axis along y through z = 1, x = 2 (the other coordinates z x)
+  w.radius = 3.0;
+  w.centre[0] = 1.0;
+  w.centre[1] = 2.0;
+  EXPECT_EQ(w.axis(), 1);
+  EXPECT_TRUE(w.is_cylinder());
+  EXPECT_FALSE(w.is_plane());
+  Body b;
+  b.radius = 0.5;
+  b.x = Vec3(2.0, 7.0, 1.0 + 2.4); // 2.4 from the axis along z: 0.6 from the surface
+  PlaneHit hit;
+  ASSERT_EQ(cylinder_hit(w, b, 0.2, hit), 1);
+  EXPECT_NEAR(hit.distance, 0.6, 1e-12);
+  EXPECT_NEAR((hit.normal - Vec3(0, 0, -1)).norm(), 0.0, 1e-12);
+  EXPECT_EQ(cylinder_hit(w, b, 0.05, hit), 0); // the gap 0.1 beyond reach
+  b.x = Vec3(2.0 + 2.7 / std::sqrt(2.0), 0.0, 1.0 + 2.7 / std::sqrt(2.0)); // overlapping 0.2
+  ASSERT_EQ(cylinder_hit(w, b, 0.0, hit), 1);
+  EXPECT_NEAR(hit.distance - b.radius, -0.2, 1e-12);
+  EXPECT_NEAR((hit.normal + Vec3(1, 0, 1) / std::sqrt(2.0)).norm(), 0.0, 1e-12);
+  b.x = Vec3(2.0, 0.0, 1.0); // on the axis: no direction, far from the wall
+  EXPECT_EQ(cylinder_hit(w, b, 1.0, hit), 0);
 }

@@ -67,6 +67,101 @@ TEST(Material, ReboundOfLammpsDampedLaws)
             rebound_restitution(NormalLaw::hertz, alpha) + 0.01);
 }
 
+namespace {
+
+// The rebound of m d'' = -K d^p - g d^q d' at approach speed v, integrated directly in the
+// deck's units (RK4, 2e5 steps over the contact): the reference for viscous_restitution.
+double direct_rebound(double m, double stiffness, double p, double g, double q, double v)
+{
+  const auto accel = [&](double d, double u) {
+    const double x = std::max(d, 0.0);
+    return -(stiffness * std::pow(x, p) + g * std::pow(x, q) * u) / m;
+  };
+  const double x0 = std::pow(m * v * v / stiffness, 1.0 / (p + 1.0));
+  const double dt = x0 / v / 20000.0;
+  double d = 0.0, u = v;
+  for (int k = 0; k < 2000000; ++k) {
+    const double a1 = accel(d, u), d1 = u;
+    const double a2 = accel(d + 0.5 * dt * d1, u + 0.5 * dt * a1), d2 = u + 0.5 * dt * a1;
+    const double a3 = accel(d + 0.5 * dt * d2, u + 0.5 * dt * a2), d3 = u + 0.5 * dt * a2;
+    const double a4 = accel(d + dt * d3, u + dt * a3), d4 = u + dt * a3;
+    const double d_next = d + dt / 6.0 * (d1 + 2 * d2 + 2 * d3 + d4);
+    const double u_next = u + dt / 6.0 * (a1 + 2 * a2 + 2 * a3 + a4);
+    if (k > 0 && d_next <= 0.0) return -(u + d / (d - d_next) * (u_next - u)) / v;
+    d = d_next;
+    u = u_next;
+  }
+  return 0.0;
+}
+
+} // namespace
+
+// LAMMPS's viscous damping models (velocity, mass_velocity, viscoelastic) have no single e: the
+// rebound depends on the impact. Hooke with a linear dashpot is the damped oscillator,
+// e = exp(-pi zeta / sqrt(1 - zeta^2)); Hertz with viscoelastic damping against a direct
+// integration of the law in the deck's units (pour.flatwall's type 2 and its floor).
+TEST(Material, ViscousReboundDependsOnTheImpact)
+{
+  PairCoefficients p;
+  p.normal = NormalLaw::hooke;
+  p.k_n = 2000.0;
+  p.viscous = ViscousDamping::mass_velocity;
+  p.viscous_coeff = 50.0;
+  for (double m : {0.1, 0.5, 2.0}) {
+    const double zeta = 50.0 / (2.0 * std::sqrt(2000.0 / m));
+    const double e = zeta < 1 ? std::exp(-M_PI * zeta / std::sqrt(1.0 - zeta * zeta)) : 0.0;
+    for (double v : {0.1, 3.0})
+      EXPECT_NEAR(viscous_restitution(p, m, 0.25, v), e, 2e-3) << "m " << m << " v " << v;
+  }
+  p.viscous = ViscousDamping::velocity; // c: the same oscillator with gamma = c / m
+  const double zeta = 50.0 / 0.5 / (2.0 * std::sqrt(2000.0 / 0.5));
+  EXPECT_NEAR(viscous_restitution(p, 0.5, 0.25, 1.0),
+              std::exp(-M_PI * zeta / std::sqrt(1.0 - zeta * zeta)), 2e-3);
+  // hertz 200, viscoelastic 20 (F = k a d + c m a d', a = sqrt(r d)); the floor's
+  // hertz/material 1e5 1e3 0.3, k_n = 4/3 E / (2 (1 - nu)), c 1000
+  p.normal = NormalLaw::hertz;
+  p.viscous = ViscousDamping::viscoelastic;
+  double last = 1.0;
+  for (double v : {0.5, 2.0, 5.0, 17.0}) {
+    p.k_n = 200.0;
+    p.viscous_coeff = 20.0;
+    const double r = 0.19, m = 0.1;
+    const double e = viscous_restitution(p, m, r, v);
+    EXPECT_NEAR(e, direct_rebound(m, 200.0 * std::sqrt(r), 1.5, 20.0 * m * std::sqrt(r), 0.5, v),
+                3e-3)
+        << "v " << v;
+    EXPECT_LT(e, last) << "faster impacts lose more"; // the dashpot grows with a
+    last = e;
+    p.k_n = 4.0 / 3.0 * 1e5 / 1.4;
+    p.viscous_coeff = 1000.0;
+    EXPECT_NEAR(
+        viscous_restitution(p, 0.5, 0.5, v),
+        direct_rebound(0.5, p.k_n * std::sqrt(0.5), 1.5, 1000.0 * 0.5 * std::sqrt(0.5), 0.5, v),
+        3e-3)
+        << "wall, v " << v;
+  }
+  p.viscous = ViscousDamping::none;
+  EXPECT_EQ(viscous_restitution(p, 0.5, 0.5, 1.0), -1.0);
+}
+
+// A wall's own material is a type whose pair with every type is the wall's.
+TEST(Material, AddedTypeIsEveryTypesPartner)
+{
+  MaterialTable table(2);
+  table.at(1, 1).mu = 0.1;
+  table.at(1, 2).mu = 0.2;
+  table.at(2, 2).mu = 0.3;
+  PairCoefficients wall;
+  wall.set = true;
+  wall.mu = 0.7;
+  EXPECT_EQ(table.add_type(wall), 3);
+  EXPECT_EQ(table.ntypes(), 3);
+  EXPECT_EQ(table.at(1, 1).mu, 0.1);
+  EXPECT_EQ(table.at(2, 1).mu, 0.2);
+  EXPECT_EQ(table.at(2, 2).mu, 0.3);
+  for (int i = 1; i <= 3; ++i) EXPECT_EQ(table.at(i, 3).mu, 0.7) << i;
+}
+
 TEST(Material, MixingIsGeometric)
 {
   MaterialTable t(3);

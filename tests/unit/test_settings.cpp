@@ -105,6 +105,21 @@ TEST(Settings, EveryKeywordSetsWhatItNames)
   EXPECT_DOUBLE_EQ(s.walls[1].lo, -1.0);
   EXPECT_DOUBLE_EQ(s.walls[1].hi, 1.0);
   EXPECT_EQ(s.walls[2].id, "box");
+  const Settings typed = parse_settings(
+      words("wall type 3 zplane 0 NULL wall granular hertz/material 1e5 1e3 0.3 tangential "
+            "mindlin NULL 1.0 0.5 zplane 0 NULL wiggle z 0.1 2 wall hooke/history 4000.0 NULL "
+            "100.0 NULL 0.5 1 region container mu 0.4"));
+  ASSERT_EQ(typed.walls.size(), 3u);
+  EXPECT_EQ(typed.walls[0].type, 3);
+  EXPECT_TRUE(typed.walls[0].model.empty());
+  EXPECT_EQ(typed.walls[1].type, 0);
+  EXPECT_EQ(typed.walls[1].model,
+            words("granular hertz/material 1e5 1e3 0.3 tangential mindlin NULL 1.0 0.5"));
+  EXPECT_EQ(typed.walls[1].kind, WallKind::zplane);
+  EXPECT_EQ(typed.walls[1].motion, WallMotion::wiggle);
+  EXPECT_EQ(typed.walls[2].model, words("hooke/history 4000.0 NULL 100.0 NULL 0.5 1"));
+  EXPECT_EQ(typed.walls[2].id, "container");
+  EXPECT_DOUBLE_EQ(typed.model.friction.mu, 0.4);
   const Settings mesh = parse_settings(words("wall mesh hopper wall zplane 0 NULL"));
   ASSERT_EQ(mesh.walls.size(), 2u);
   EXPECT_EQ(mesh.walls[0].kind, WallKind::mesh);
@@ -216,8 +231,27 @@ TEST(Settings, BadInputNamesTheKeywordAndItsForm)
   EXPECT_EQ(error_of("wall region"), "expected 'wall region <region-ID>'");
   EXPECT_EQ(error_of("wall mesh"), "expected 'wall mesh <fix-ID>' (a fix mesh/surface)");
   EXPECT_EQ(error_of("wall cylinder 3"),
-            "expected 'wall xplane|yplane|zplane <lo|NULL> <hi|NULL>', 'wall region <region-ID>' "
-            "or 'wall mesh <fix-ID>', got 'cylinder'");
+            "expected 'wall xplane|yplane|zplane <lo|NULL> <hi|NULL>', 'wall "
+            "xcylinder|ycylinder|zcylinder <radius> [<c1> <c2>]', 'wall region <region-ID>' or "
+            "'wall mesh <fix-ID>' (optionally 'type <T>' or fix wall/gran's interaction after "
+            "'wall'), got 'cylinder'");
+  // a wall's own material: an atom type, or the interaction words of the fix wall/gran it
+  // replaces, up to the wall's style
+  EXPECT_EQ(error_of("wall type 0 zplane 0 NULL"),
+            "expected 'wall type <T> <style> ...' (T an atom type), got '0'");
+  EXPECT_EQ(error_of("wall granular hertz/material 1e5 0.3 0.3"),
+            "expected 'wall granular <coefficients> xplane|yplane|zplane|zcylinder|region ...' "
+            "(fix wall/gran's interaction and arguments, then the wall's style)");
+  EXPECT_EQ(error_of("wall type 1 zcylinder 0"),
+            "expected 'wall zcylinder <radius> [<c1> <c2>]' (radius > 0), got '0'");
+  EXPECT_EQ(error_of("wall zcylinder 2 0 0 wiggle z 1 1"),
+            "expected 'wall zcylinder <radius> [<c1> <c2>]' (radius > 0) without motion (a "
+            "cylinder wall stands still), got 'wiggle'");
+  EXPECT_EQ(error_of("wall type 2 cylinder 3"),
+            "expected 'wall xplane|yplane|zplane <lo|NULL> <hi|NULL>', 'wall "
+            "xcylinder|ycylinder|zcylinder <radius> [<c1> <c2>]', 'wall region <region-ID>' or "
+            "'wall mesh <fix-ID>' (optionally 'type <T>' or fix wall/gran's interaction after "
+            "'wall'), got 'cylinder'");
   EXPECT_EQ(error_of("export 10"), "expected 'export <N> <file-prefix>' (N a positive integer)");
   EXPECT_EQ(error_of("check -1"), "expected 'check <N>' (N a non-negative integer), got '-1'");
   EXPECT_EQ(error_of("check"), "expected 'check <N>' (N a non-negative integer)");

@@ -31,13 +31,15 @@ inline double mesh_key(int wall, long triangle)
 // A wall: one or two planes normal to an axis (lo below, hi above the grains), a region of the
 // front end (LAMMPS), or a triangle mesh of the front end (LIGGGHTS fix mesh/surface), named by
 // its ID.
-enum class WallKind { xplane, yplane, zplane, region, mesh };
+// A cylinder (x/y/zcylinder: fix wall/gran's and LIGGGHTS's primitive) holds the grains inside
+// it: radius, and the axis's position in the other two coordinates (y z, z x or x y).
+enum class WallKind { xplane, yplane, zplane, region, mesh, xcylinder, ycylinder, zcylinder };
 template <> struct EnumNames<WallKind> {
-  static constexpr EnumName<WallKind> table[] = {{WallKind::xplane, "xplane"},
-                                                 {WallKind::yplane, "yplane"},
-                                                 {WallKind::zplane, "zplane"},
-                                                 {WallKind::region, "region"},
-                                                 {WallKind::mesh, "mesh"}};
+  static constexpr EnumName<WallKind> table[] = {
+      {WallKind::xplane, "xplane"},       {WallKind::yplane, "yplane"},
+      {WallKind::zplane, "zplane"},       {WallKind::region, "region"},
+      {WallKind::mesh, "mesh"},           {WallKind::xcylinder, "xcylinder"},
+      {WallKind::ycylinder, "ycylinder"}, {WallKind::zcylinder, "zcylinder"}};
 };
 
 // How a plane wall moves (fix wall/gran's keywords): wiggle = oscillation along motion_axis,
@@ -53,8 +55,23 @@ struct WallSpec {
   WallMotion motion = WallMotion::none;
   int motion_axis = 0;
   double amplitude = 0.0, period = 1.0, shear_speed = 0.0;
-  int axis() const { return static_cast<int>(kind); } // planes: 0 x, 1 y, 2 z
-  bool is_plane() const { return kind != WallKind::region && kind != WallKind::mesh; }
+  // The wall's material (per-type coefficients): its contacts take the pair (sphere type,
+  // type); 0: the sphere's type with itself. `model` holds the interaction words of the fix
+  // wall/gran that the wall replaces ("granular hertz/material 1e5 0.3 0.3 ...", "hooke/history
+  // kn kt ..."), which the front end reads into a type of its own.
+  int type = 0;
+  std::vector<std::string> model;
+  double radius = 0.0, centre[2] = {0.0, 0.0}; // cylinders
+  // planes and cylinders: 0 x, 1 y, 2 z
+  int axis() const
+  {
+    return is_cylinder() ? static_cast<int>(kind) - static_cast<int>(WallKind::xcylinder)
+                         : static_cast<int>(kind);
+  }
+  bool is_plane() const { return kind <= WallKind::zplane; }
+  bool is_cylinder() const { return kind >= WallKind::xcylinder; }
+  // walls whose geometry is the library's own (planes, cylinders), not the front end's
+  bool is_primitive() const { return is_plane() || is_cylinder(); }
   // The planes' displacement along their own axis and their velocity at time t since the
   // wall was defined.
   double offset(double t) const;
@@ -98,6 +115,9 @@ struct PlaneHit {
 };
 // t: time since the wall was defined (moving planes).
 int plane_hits(const WallSpec &wall, const Body &b, double reach, PlaneHit hits[2], double t = 0.0);
+// A cylinder wall within `reach` of the sphere's surface (the sphere inside it): the normal
+// towards the axis and the centre's distance from the surface. Returns 0 or 1.
+int cylinder_hit(const WallSpec &wall, const Body &b, double reach, PlaneHit &hit);
 
 // One contact found by a front end, before the system is built.
 struct DetectedContact {

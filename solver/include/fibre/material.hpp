@@ -73,6 +73,9 @@ class MaterialTable {
   // coefficient, which is what LAMMPS mixes). Returns "" or what cannot be mixed (a type
   // without coefficients, or two twisting laws).
   std::string mix();
+  // A new type T = ntypes() + 1 whose pair with every type, itself included, is p: a wall's own
+  // material, which every sphere type meets alike. Returns T.
+  int add_type(const PairCoefficients &p);
   // One line per type pair i <= j for the log: "1 1: mu 0.4, mu_roll 0.1, twisting sds 0.07,
   // restitution 0.3".
   std::vector<std::string> describe() const;
@@ -99,6 +102,13 @@ double liggghts_hertz_damping(double e);
 // limit_damping until the force vanishes. Tsuji's fit names another e: LAMMPS's `hertz/material
 // E 0.1 ...` rebounds at 0.234.
 double rebound_restitution(NormalLaw law, double alpha, bool limit_damping = false);
+
+// The coefficient of restitution of a head-on impact at approach speed v under the pair's
+// normal law with LAMMPS's viscous dashpot (velocity c, mass_velocity c m_eff, viscoelastic
+// c m_eff a), for reduced mass m_eff and effective radius r_eff: the law in units of its deepest
+// overlap and approach speed has one parameter, whose rebound is integrated once per law on a
+// grid and interpolated. -1 where p has no viscous damping or no normal law.
+double viscous_restitution(const PairCoefficients &p, double m_eff, double r_eff, double v);
 
 // The friction of one contact (radius r_eff, overlap >= 0) from its pair's coefficients:
 // mu_twist per unit r_eff as FrictionParams keeps it.
