@@ -59,7 +59,7 @@ def box_figures(run):
     return out
 
 
-def flatwall_figures(run):
+def printed_figures(run):
     m = re.search(r"^FIGURES (.*)$", run["log"], re.M)
     if not m:
         return {}
@@ -73,6 +73,43 @@ variable na equal count(all)
 variable zc equal xcm(all,z)
 print "FIGURES atoms ${na} zc ${zc}"
 """
+
+
+# pour.drum's figure: the spheres left, and where the bed's centre sits in the drum rotating
+# about z with gravity along -y (its x shift is the bed climbing the rising wall)
+DRUM_FIGURES = """
+variable na equal count(all)
+variable xc equal xcm(all,x)
+variable yc equal xcm(all,y)
+variable zc equal xcm(all,z)
+print "FIGURES atoms ${na} xc ${xc} yc ${yc} zc ${zc}"
+"""
+
+
+def mixer_deck(text):
+    """granregion.mixer with its thermo extended: rotational energy, the bed's centre height
+    and the highest grain."""
+    old = "thermo_style\tcustom step cpu atoms ke v_theta"
+    assert old in text
+    return text.replace(old, "compute rke all erotate/sphere\nvariable zc equal xcm(all,z)\n"
+                        "variable zmax equal bound(all,zmax)\n" + old + " c_rke v_zc v_zmax")
+
+
+def mixer_figures(run):
+    """Spheres at the end; over the second half of the mixing stage (the second run; its
+    first half still has the last insertion falling) the mean kinetic and rotational energy
+    and bed centre height, and the highest grain."""
+    blocks = run["thermo"]
+    if len(blocks) < 2:
+        return {}
+    rows = blocks[1][len(blocks[1]) // 2:]
+    mean = lambda key: sum(r[key] for r in rows) / len(rows)  # noqa: E731
+    return {"atoms": blocks[-1][-1]["Atoms"], "ke": mean("KinEng"), "rke": mean("c_rke"),
+            "zc": mean("v_zc"), "zmax": max(r["v_zmax"] for r in rows)}
+
+
+def with_drum_figures(text):
+    return text + DRUM_FIGURES
 
 
 def same(text):
@@ -92,10 +129,14 @@ def bed_deck(text):
 DECKS = {
     "granregion.box": ("lammps", "granregion/in.granregion.box", box_deck, same, box_figures),
     "pour.flatwall": ("lammps", "granular/in.pour.flatwall", same, with_figures,
-                      flatwall_figures),
+                      printed_figures),
+    "granregion.mixer": ("lammps", "granregion/in.granregion.mixer", same, mixer_deck,
+                         mixer_figures),
+    "pour.drum": ("lammps", "granular/in.pour.drum", same, with_drum_figures,
+                  printed_figures),
     "cohesion.noCohesion": ("liggghts", "cohesion/in.noCohesion", same, bed_deck,
-                            flatwall_figures),
-    "cohesion.cohesion": ("liggghts", "cohesion/in.cohesion", same, bed_deck, flatwall_figures),
+                            printed_figures),
+    "cohesion.cohesion": ("liggghts", "cohesion/in.cohesion", same, bed_deck, printed_figures),
 }
 
 
