@@ -76,8 +76,9 @@ void apply_pair(const ContactModel &model, const PairCoefficients &pc, const Spo
   // a viscous dashpot's rebound depends on the impact: its masses, radii and approach speed
   // (the law's; under compliance auto the gran/* styles' kn is no material)
   if (!typed.restitution && pc.restitution < 0 && last_normal == 0) {
+    const double reach = bodies[c.a].radius + (c.is_wall() ? 0.0 : bodies[c.b].radius);
     const double e =
-        viscous_restitution(pc, effective_mass(bodies, c), reff, normal_approach(bodies, c));
+        viscous_restitution(pc, effective_mass(bodies, c), reff, normal_approach(bodies, c), reach);
     if (e >= 0) c.restitution = e;
   }
   const int rows = model.rows;

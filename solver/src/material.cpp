@@ -188,7 +188,8 @@ double rebound_restitution(NormalLaw law, double alpha, bool limit_damping)
                                  : rebound(1.5, 0.25, alpha, limit_damping);
 }
 
-double viscous_restitution(const PairCoefficients &p, double m_eff, double r_eff, double v)
+double viscous_restitution(const PairCoefficients &p, double m_eff, double r_eff, double v,
+                           double reach)
 {
   if (p.viscous == ViscousDamping::none || p.normal == NormalLaw::none || !(m_eff > 0) ||
       !(v > 0) || !(p.k_n > 0))
@@ -204,10 +205,18 @@ double viscous_restitution(const PairCoefficients &p, double m_eff, double r_eff
   double g = p.viscous_coeff;
   if (p.viscous != ViscousDamping::velocity) g *= m_eff;
   if (visco) g *= std::sqrt(r_eff);
-  const double x0 = std::pow(m_eff * v * v / stiffness, 1.0 / (pw + 1.0));
-  const double beta = g * std::pow(x0, q + 1.0) / (m_eff * v);
+  // The undamped law's deepest overlap is ((pw + 1) / 2)^(1 / (pw + 1)) x0. Where it reaches
+  // the centres the law would pass the bodies through each other: the spring stores at most
+  // the energy of the impact v_reach whose overlap just reaches them, the rest is lost, and
+  // the bodies part at most at the rebound of v_reach.
+  const double deepest = std::pow((pw + 1.0) / 2.0, 1.0 / (pw + 1.0));
+  double speed = v;
+  if (reach > 0 && deepest * std::pow(m_eff * v * v / stiffness, 1.0 / (pw + 1.0)) > reach)
+    speed = std::sqrt(stiffness * std::pow(reach / deepest, pw + 1.0) / m_eff);
+  const double x0 = std::pow(m_eff * speed * speed / stiffness, 1.0 / (pw + 1.0));
+  const double beta = g * std::pow(x0, q + 1.0) / (m_eff * speed);
   const int law = (hooke ? 0 : 4) + (visco ? 2 : 0) + (p.limit_damping ? 1 : 0);
-  return tabulated_rebound(law, pw, q, p.limit_damping, beta);
+  return tabulated_rebound(law, pw, q, p.limit_damping, beta) * speed / v;
 }
 
 FrictionParams contact_friction(const PairCoefficients &p, double r_eff, double overlap)

@@ -140,6 +140,20 @@ TEST(Material, ViscousReboundDependsOnTheImpact)
         3e-3)
         << "wall, v " << v;
   }
+  // pour.flatwall's type 2 (hertz 200, viscoelastic 20), two spheres of d 0.5 (m_eff 0.0327):
+  // at 15 closing the law's deepest overlap (5/4)^(2/5) (m v^2 / K)^(2/5) is 0.44 < 0.5 and
+  // they rebound (native at 0.871); at 30 it is 0.76: native passes them through each other.
+  // Here they part at the rebound of v_reach, the impact whose deepest overlap is 0.5.
+  p.k_n = 200.0;
+  p.viscous_coeff = 20.0;
+  const double m2 = M_PI / 6.0 * 0.125 / 2.0, stiff = 200.0 * std::sqrt(0.125);
+  EXPECT_NEAR(viscous_restitution(p, m2, 0.125, 15.0, 0.5), 6.531 / 7.5, 5e-3);
+  const double v_reach = std::sqrt(stiff * std::pow(0.5 / std::pow(1.25, 0.4), 2.5) / m2);
+  EXPECT_NEAR(viscous_restitution(p, m2, 0.125, 30.0, 0.5),
+              viscous_restitution(p, m2, 0.125, v_reach) * v_reach / 30.0, 1e-12);
+  EXPECT_NEAR(direct_rebound(m2, stiff, 1.5, 20.0 * m2 * std::sqrt(0.125), 0.5, v_reach) * v_reach,
+              viscous_restitution(p, m2, 0.125, 30.0, 0.5) * 30.0, 0.05);
+  EXPECT_GT(viscous_restitution(p, m2, 0.125, 30.0), 0.5); // without the reach
   p.viscous = ViscousDamping::none;
   EXPECT_EQ(viscous_restitution(p, 0.5, 0.5, 1.0), -1.0);
 }

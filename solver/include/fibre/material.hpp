@@ -107,8 +107,13 @@ double rebound_restitution(NormalLaw law, double alpha, bool limit_damping = fal
 // normal law with LAMMPS's viscous dashpot (velocity c, mass_velocity c m_eff, viscoelastic
 // c m_eff a), for reduced mass m_eff and effective radius r_eff: the law in units of its deepest
 // overlap and approach speed has one parameter, whose rebound is integrated once per law on a
-// grid and interpolated. -1 where p has no viscous damping or no normal law.
-double viscous_restitution(const PairCoefficients &p, double m_eff, double r_eff, double v);
+// grid and interpolated. -1 where p has no viscous damping or no normal law. reach (> 0): the
+// overlap at which the centres meet (r_a + r_b, a wall's sphere r_a). An impact whose undamped
+// deepest overlap would pass it is beyond the law (a soft contact passes the bodies through each
+// other): its spring stores at most the energy of the impact v_reach that just reaches the
+// centres, and the bodies part at e(v_reach) v_reach.
+double viscous_restitution(const PairCoefficients &p, double m_eff, double r_eff, double v,
+                           double reach = 0.0);
 
 // The friction of one contact (radius r_eff, overlap >= 0) from its pair's coefficients:
 // mu_twist per unit r_eff as FrictionParams keeps it.
