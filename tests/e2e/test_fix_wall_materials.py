@@ -19,13 +19,7 @@ import math
 
 import fibre_e2e as e2e
 
-BASE = """atom_style sphere
-atom_modify map array
-boundary f f f
-newton off
-comm_modify vel yes
-region box block -3 3 -3 3 -1 5 units box
-create_box 2 box
+BASE = "\n".join(e2e.sphere_box("-3 3 -3 3 -1 5", types=2)) + """
 create_atoms 1 single {x0} 0 0.6 units box
 set atom 1 diameter 1.0 density 1.0
 pair_style granular
