@@ -188,8 +188,9 @@ bool ContactModel::may_bounce() const
   if (!per_type() || typed.restitution) return false;
   for (int i = 1; i <= materials.ntypes(); ++i)
     for (int j = i; j <= materials.ntypes(); ++j)
-      if (materials.at(i, j).restitution > 0 || materials.at(i, j).viscous != ViscousDamping::none)
-        return true;
+      if (materials.at(i, j).restitution > 0 ||
+          (compliance.material && materials.at(i, j).viscous != ViscousDamping::none))
+        return true; // a viscous law rebounds under compliance material only (apply_pair)
   return false;
 }
 
