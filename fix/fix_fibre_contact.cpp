@@ -609,8 +609,9 @@ void FixFibreContact::warn_deep_overlaps(const std::vector<fibre::Body> &bodies,
          "Fix fibre_contact: the run starts with overlaps of up to " +
              fibre::format_g(100.0 * deepest) +
              "% of a diameter; they are removed at recovery_speed " +
-             (max_recovery > 0 ? fibre::format_g(max_recovery) : "none") +
-             " (SPOOK removes any overlap within a few steps otherwise)");
+             (max_recovery > 0 ? fibre::format_g(max_recovery) +
+                                     " at most (and no faster than the material's spring)"
+                               : "none (SPOOK removes any overlap within a few steps)"));
 }
 
 /* ----------------------------------------------------------------------
@@ -896,13 +897,20 @@ void FixFibreContact::unpack_restart(int nlocal, int nth)
   const int count = static_cast<int>(extra[m]);
   const int n = static_cast<int>(extra[m + 1]);
   using fibre::ContactHistory;
-  // restart files written before session 46 hold no pending displacement, and those written
-  // before the springs 7 values per slot
-  const bool pending = count - 2 - kPendingValues == n * ContactHistory::kSlotSize;
+  // older restart files: 14 values per slot (no penetration), before that no pending
+  // displacement, and before the springs 7 values per slot
+  int slot = ContactHistory::kSlotSize;
+  bool pending = true;
+  if (n > 0 && count - 2 - kPendingValues == n * ContactHistory::kSpringSlot) {
+    slot = ContactHistory::kSpringSlot;
+  } else if (count - 2 - kPendingValues != n * ContactHistory::kSlotSize) {
+    pending = false;
+    if (n > 0 && count - 2 == n * ContactHistory::kWarmStartSlot)
+      slot = ContactHistory::kWarmStartSlot;
+    else
+      slot = ContactHistory::kSpringSlot;
+  }
   const int values = count - 2 - (pending ? kPendingValues : 0);
-  const int slot = n > 0 && values == n * ContactHistory::kWarmStartSlot
-                       ? ContactHistory::kWarmStartSlot
-                       : ContactHistory::kSlotSize;
   history_.unpack(nlocal, extra + m + 1, values, slot);
   pending_[nlocal] = {0.0, 0.0, 0.0};
   if (pending)

@@ -90,6 +90,7 @@ void ContactHistory::load_springs(const std::vector<DetectedContact> &found,
   for (std::size_t c = 0; c < found.size(); ++c) {
     Contact &k = contacts[c];
     k.spring.fill(0.0);
+    k.penetration = 0.0;
     const double *slot = find(found[c].store, found[c].key);
     if (!slot) continue;
     const Vec3 tangential = into_plane(Vec3(slot[7], slot[8], slot[9]), k.normal);
@@ -99,6 +100,7 @@ void ContactHistory::load_springs(const std::vector<DetectedContact> &found,
     k.spring[3] = slot[13];
     k.spring[4] = rolling.dot(k.t1);
     k.spring[5] = rolling.dot(k.t2);
+    k.penetration = slot[14];
   }
 }
 
@@ -124,12 +126,13 @@ long ContactHistory::store(const std::vector<DetectedContact> &found, const Vect
     double *slot = slots(s) + std::size_t(count_[s]++) * kSlotSize;
     slot[0] = fc.key;
     Vec3 tangential = Vec3::Zero(), rolling = Vec3::Zero();
-    double twisting = 0.0;
+    double twisting = 0.0, penetration = 0.0;
     if (springs) {
       const std::array<double, kMaxRows> &xi = (*springs)[c];
       tangential = xi[1] * k.t1 + xi[2] * k.t2;
       rolling = xi[4] * k.t1 + xi[5] * k.t2;
       twisting = xi[3];
+      penetration = xi[0];
     }
     for (int d = 0; d < 3; ++d) {
       slot[1 + d] = force[d];
@@ -138,6 +141,7 @@ long ContactHistory::store(const std::vector<DetectedContact> &found, const Vect
       slot[10 + d] = rolling[d];
     }
     slot[13] = twisting;
+    slot[14] = penetration;
   }
   return overflow;
 }

@@ -61,6 +61,27 @@ void shorten_to_collision(const PairCoefficients &pc, const SpookParams &params,
     }
 }
 
+// Contact::penetration: the part of the overlap beyond what the contact's last load explains
+// (the law's overlap at that force) and the closing within a step (twice its approach speed's,
+// for the step's acceleration; nothing for a contact that opens), where it is more than
+// max_recovery removes in a step. A penetration only shrinks with the overlap, whatever the
+// recovery's force; it is gone with it.
+void track_penetration(const PairCoefficients &pc, const SpookParams &params, double reff,
+                       double overlap, double force, double approach, Contact &c)
+{
+  if (!(params.max_recovery > 0)) {
+    c.penetration = 0.0;
+    return;
+  }
+  if (c.penetration > 0) {
+    c.penetration = std::min(c.penetration, overlap);
+    return;
+  }
+  const double explained = law_overlap(pc, reff, force) + 2.0 * params.h * std::max(approach, 0.0);
+  const double excess = overlap - explained;
+  c.penetration = excess > params.h * params.max_recovery ? excess : 0.0;
+}
+
 void apply_pair(const ContactModel &model, const PairCoefficients &pc, const SpookParams &params,
                 double reff, const std::vector<Body> &bodies, double last_normal, Contact &c)
 {
@@ -83,8 +104,13 @@ void apply_pair(const ContactModel &model, const PairCoefficients &pc, const Spo
   }
   const int rows = model.rows;
   const double force = last_normal / h;
+  track_penetration(pc, params, reff, overlap, force, normal_approach(bodies, c), c);
   const std::array<double, kMaxRows> rigid = c.compliance;
-  material_compliance(pc, reff, overlap, force, rigid, c.compliance, c.elastic);
+  // A penetration's row keeps the law's compliance at its overlap (its last force was the
+  // recovery's), so that it leaves no faster than the law's spring would push it: a soft
+  // material's overlap is removed slower than the recovery speed, as native's is.
+  material_compliance(pc, reff, overlap, c.penetration > 0 ? 0.0 : force, rigid, c.compliance,
+                      c.elastic);
   for (int r = rows; r < kMaxRows; ++r) c.elastic[r] = false;
   // A loaded contact's normal row is a Kelvin-Voigt element with the law's own dashpot (damping
   // time gamma_n / k), at least SPOOK's d, below which a contact stiffer than the step rings

@@ -232,6 +232,13 @@ FrictionParams contact_friction(const PairCoefficients &p, double r_eff, double 
   return f;
 }
 
+double law_overlap(const PairCoefficients &p, double r_eff, double f)
+{
+  if (p.normal == NormalLaw::none || !(p.k_n > 0) || !(f > 0)) return 0.0;
+  if (p.normal == NormalLaw::hooke) return f / p.k_n;
+  return r_eff > 0 ? std::cbrt(f * f / (p.k_n * p.k_n * r_eff)) : 0.0;
+}
+
 bool material_compliance(const PairCoefficients &p, double r_eff, double overlap, double last_force,
                          const std::array<double, kMaxRows> &rigid,
                          std::array<double, kMaxRows> &eps, std::array<bool, kMaxRows> &elastic)
@@ -247,7 +254,7 @@ bool material_compliance(const PairCoefficients &p, double r_eff, double overlap
   // normal row stays rigid and the springs that need a contact radius vanish with a = 0
   double a = 0.0;
   if (f > 0) {
-    const double d = hertz ? std::cbrt(f * f / (p.k_n * p.k_n * r_eff)) : f / p.k_n;
+    const double d = law_overlap(p, r_eff, f);
     eps[0] = d / f;
     elastic[0] = true; // the gap is the law's overlap at the load
     a = std::sqrt(r_eff * d);

@@ -83,7 +83,11 @@ Substeps run_substeps(int n, const ContactModel &model, const SpookParams &param
             for (std::size_t k = 0; k < c.size(); ++k) {
               const double wall = walls_move ? wall_rows(c[k])[0] : 0.0;
               c[k].gap += h * (Gv[Eigen::Index(rows) * Eigen::Index(k)] - wall);
-              if (!springs.empty()) c[k].spring = springs[k];
+              if (!springs.empty()) {
+                c[k].spring = springs[k];
+                c[k].penetration = springs[k][0];
+                c[k].spring[0] = 0.0;
+              }
             }
             for (std::size_t i = 0; i < b.size(); ++i) {
               b[i].v = v_plus.segment<3>(6 * Eigen::Index(i));

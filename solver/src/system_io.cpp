@@ -28,7 +28,9 @@ constexpr int kContactFieldsV5 = kContactFieldsV3 + kMaxRows;
 constexpr int kContactFieldsV6 = kContactFieldsV5 + 1;
 // version 7: + the springs' own damping (rows 1..5, -1 for the contact's)
 // version 8: the same, with bit 6 of the elastic rows for an implicit normal row
-constexpr int kContactFields = kContactFieldsV6 + kMaxRows - 1;
+constexpr int kContactFieldsV8 = kContactFieldsV6 + kMaxRows - 1;
+// version 9: + the normal row's penetration (Contact::penetration)
+constexpr int kContactFields = kContactFieldsV8 + 1;
 // Unit vectors must read back as unit vectors; exported data are far more exact than this.
 constexpr double kUnitTol = 1e-6;
 
@@ -251,6 +253,8 @@ void write_system(std::ostream &out, const ContactSystem &sys)
       s += ' ';
       put_real(s, c.spring_damping[r]);
     }
+    s += ' ';
+    put_real(s, c.penetration);
     s += '\n';
     out << s;
   }
@@ -293,6 +297,7 @@ ContactSystem parse_system(std::string_view text)
                              : version == 3 ? kContactFieldsV3
                              : version <= 5 ? kContactFieldsV5
                              : version == 6 ? kContactFieldsV6
+                             : version <= 8 ? kContactFieldsV8
                                             : kContactFields;
 
   in.keyword(t, "rows", 1, "rows <3|6>");
@@ -427,6 +432,10 @@ ContactSystem parse_system(std::string_view text)
         in.fail(what + ": a spring's damping must be non-negative, or -1 for the contact's");
       k.spring_damping[r] = d;
     }
+    if (version <= 8) continue;
+    k.penetration = in.real(t[kContactFieldsV8], what + " penetration");
+    if (!(k.penetration >= 0) || (k.penetration > 0 && !(k.penetration <= -k.gap)))
+      in.fail(what + ": the penetration must be in [0, the overlap]");
   }
 
   const long long dofs = rows * nc;

@@ -510,6 +510,78 @@ TEST(ContactSolver, RecoverySpeedBoundsRigidRowsNotTheMaterialsSpring)
   EXPECT_LE(vz, v_rec * (1.0 + 1e-6));
 }
 
+// A deep start under compliance material: a sphere created 20% of its diameter into the floor,
+// with no load behind the overlap, on a law whose spring would release the overlap's Hertz
+// energy within a few steps. The overlap is a penetration (Contact::penetration, carried from
+// step to step as the fix's history does): the sphere rises at the recovery speed, never
+// faster, and comes to rest at Hertz's overlap under its weight. Without the bound (recovery
+// speed 0: none) the same start leaves at many times that speed.
+namespace {
+
+struct DeepStart {
+  double fastest = 0.0, overlap = 0.0, force = 0.0, last_speed = 0.0;
+};
+
+DeepStart deep_start(double v_rec, int steps)
+{
+  const double m = 0.2, r = 0.25;
+  PairCoefficients law;
+  law.set = true;
+  law.normal = NormalLaw::hertz_material;
+  law.k_n = 5e8;
+  ContactModel model;
+  model.compliance.automatic = false;
+  model.compliance.material = true;
+  model.rows = 3;
+  model.materials = MaterialTable(1);
+  model.materials.at(1, 1) = law;
+  SpookParams params = spook();
+  params.max_recovery = v_rec;
+  StepOptions o = base_options();
+  o.stop.tol = 1e-10;
+  std::vector<Body> bodies{sphere(m, r, Vec3(0, 0, r - 0.4 * r))};
+  bodies[0].type = 1;
+  Vector last = Vector::Zero(3);
+  double penetration = 0.0; // what the history carries
+  DeepStart out;
+  for (int s = 0; s < steps; ++s) {
+    std::vector<Contact> contacts{sphere_wall_contact(bodies, 0, Vec3::UnitZ(), bodies[0].x.z())};
+    contacts[0].penetration = penetration;
+    apply_contact_model(model, params, m, bodies, contacts, &last);
+    ContactSystem sys(bodies, contacts, 3, params);
+    const StepResult res = solve(sys, o);
+    EXPECT_TRUE(res.converged);
+    last = res.lambda;
+    const Vector v_plus = velocities_after(sys, serial_exchange(), res.lambda);
+    penetration = advance_springs(sys, v_plus, res.lambda)[0][0];
+    bodies[0].v = v_plus.head<3>();
+    bodies[0].x += kH * bodies[0].v;
+    out.fastest = std::max(out.fastest, bodies[0].v.z());
+    out.force = res.lambda[0] / kH;
+  }
+  out.overlap = r - bodies[0].x.z();
+  out.last_speed = bodies[0].v.z();
+  return out;
+}
+
+} // namespace
+
+TEST(ContactSolver, DeepStartLeavesAtTheRecoverySpeedWhateverTheMaterial)
+{
+  const double m = 0.2, r = 0.25, v_rec = 0.05, k_n = 5e8;
+  const double weight = m * kG;
+  const double d_eq = std::cbrt(weight * weight / (k_n * k_n * r));
+  // 0.1 r at 0.05 a step of 1e-3 takes 2,000 steps; 3,000 to settle
+  const DeepStart bounded = deep_start(v_rec, 3000);
+  EXPECT_LE(bounded.fastest, v_rec * (1.0 + 1e-6));
+  EXPECT_GT(bounded.fastest, 0.95 * v_rec);
+  EXPECT_NEAR(bounded.overlap, d_eq, 1e-3 * d_eq);
+  EXPECT_NEAR(bounded.force, weight, 1e-3 * weight);
+  EXPECT_NEAR(bounded.last_speed, 0.0, 1e-6);
+  const DeepStart unbounded = deep_start(0.0, 20);
+  EXPECT_GT(unbounded.fastest, 20.0 * v_rec);
+}
+
 // SPOOK's damping d (in steps) of a contact stiffer than the step can resolve: the step maps the
 // overlap's deviation e from its rest value as a linear recurrence with the characteristic
 // polynomial mu^2 - (1 - 3 Y) mu + Y, Y = 1 / (1 + 4 d) (doc/design.md section 2). d = 2 is its

@@ -19,8 +19,9 @@ class ContactHistory {
   static constexpr int kMaxSlots = 16;
   // key (the other side's tag, or a wall key), then force and torque (impulse / h) acting on
   // the contact's body a, then the tangential displacement (3), the rolling angle (3) and the
-  // twisting angle (1).
-  static constexpr int kSlotSize = 14;
+  // twisting angle (1), and the penetration left (Contact::penetration).
+  static constexpr int kSlotSize = 15;
+  static constexpr int kSpringSlot = 14; // files without the penetration
   static constexpr int kMaxPacked = 1 + kMaxSlots * kSlotSize;
 
   void grow(int nmax); // room for atoms [0, nmax); new atoms have no contacts
@@ -32,7 +33,7 @@ class ContactHistory {
   int pack(int i, double *buf) const;
   // Atom i <- [n, slots] from buf, trusting at most `available` values after n; returns the
   // number of values read. slot_size: the writer's (kWarmStartSlot: files without springs,
-  // which read back with zero springs).
+  // which read back with zero springs; kSpringSlot: without penetrations).
   static constexpr int kWarmStartSlot = 7;
   int unpack(int i, const double *buf, int available = kMaxSlots * kSlotSize,
              int slot_size = kSlotSize);
@@ -43,11 +44,13 @@ class ContactHistory {
   Vector warm_start(const std::vector<DetectedContact> &found, int rows, double h) const;
   // Contact::spring of every stored contact in this step's frame: the stored tangential and
   // rolling vectors turned into the new tangent plane with their length kept (LAMMPS's rule),
-  // the twisting angle as it is. `contacts` are the found ones, in their order.
+  // the twisting angle as it is; and Contact::penetration. `contacts` are the found ones, in their
+  // order.
   void load_springs(const std::vector<DetectedContact> &found,
                     std::vector<Contact> &contacts) const;
   // Replaces every stored contact of atoms [0, nlocal) by this step's pressing contacts, with
-  // their springs at the step's end (advance_springs, rows per contact; null: none).
+  // their springs at the step's end (advance_springs, rows per contact, row 0 the penetration
+  // left; null: none).
   // Returns how many did not fit (more than kMaxSlots on one atom).
   long store(const std::vector<DetectedContact> &found, const Vector &lambda, int rows, double h,
              int nlocal, const std::vector<std::array<double, kMaxRows>> *springs = nullptr);

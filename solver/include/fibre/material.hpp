@@ -119,6 +119,9 @@ double viscous_restitution(const PairCoefficients &p, double m_eff, double r_eff
 // mu_twist per unit r_eff as FrictionParams keeps it.
 FrictionParams contact_friction(const PairCoefficients &p, double r_eff, double overlap);
 
+// The law's overlap under a normal load f (0 without a normal law or a load).
+double law_overlap(const PairCoefficients &p, double r_eff, double f);
+
 // `compliance material` (doc/design.md section 2, "Material"): the rows' compliances from the
 // pair's elastic laws at the reference load F = max(the contact's last normal force, the law's
 // force at its overlap). Normal row: the secant compliance d(F) / F, so that a contact at rest

@@ -49,7 +49,8 @@ ContactWork contact_work(const ContactSystem &sys, const Vector &Gv_plus, const 
 // rescaling), so that a sliding contact snaps back by its elastic part only; a spring with a
 // damper of its own (Contact::damper_time tau = gamma / k: SDS rolling and twisting) keeps that
 // less the damper's share, tau G v+, as LAMMPS's SDS laws do, less what SPOOK's row already
-// takes from its slowing. Zero on rows that are not elastic. v_plus: velocities_after(sys, ex,
+// takes from its slowing. Zero on rows that are not elastic. Row 0 carries what is left of
+// the contact's penetration (Contact::penetration). v_plus: velocities_after(sys, ex,
 // lambda). Gv_plus: G v_plus where the caller has it.
 std::vector<std::array<double, kMaxRows>> advance_springs(const ContactSystem &sys,
                                                           const Vector &v_plus,

@@ -78,9 +78,16 @@ struct Contact {
   // carries the gap: rows 1, 2 the tangential displacement (length), 3 the twisting and 4, 5
   // the rolling angle. Without the displacement a compliance would be a viscosity. An elastic
   // normal row (row 0, its displacement the gap, spring[0] unused) is the law's spring: its
-  // overlap is the load's, not an error, so max_recovery does not bound it.
+  // overlap is the load's, not an error, so max_recovery does not bound it (but its
+  // penetration).
   std::array<bool, kMaxRows> elastic{};
   std::array<double, kMaxRows> spring{};
+  // The part of an elastic normal row's overlap that no load explains (a start or an insertion
+  // into other bodies, a jump in size): a penetration, whose gap term is bounded as a rigid
+  // row's, so that it is removed no faster than max_recovery (nor than the law's spring at the
+  // row's compliance pushes), where the spring alone would release the overlap's whole energy
+  // within a few steps. It only shrinks (contact_model.cpp; the history keeps it).
+  double penetration = 0.0;
   // An elastic normal row relaxed as the law's Kelvin-Voigt element (spring 1 / eps, dashpot
   // time tau) by implicit Euler, G v+ (h + tau) + eps lambda / h = -gap: SPOOK's row at
   // damping = 3/4 + tau / h without the memory Upsilon G v of the approach speed (spook_rhs).
@@ -173,10 +180,17 @@ struct SpookParams {
   // The gap term of the normal row's rhs, -(4 / h) Upsilon g, bounded by max_recovery unless
   // the row is the material's spring (Contact::elastic[0]): bounding an elastic overlap would
   // bound the force the contact can carry, and a wedged sphere would stay deep in.
-  double gap_term(double gap, double ups, bool elastic = false) const
+  // An elastic row's penetration (Contact::penetration) is bounded as a rigid row's overlap.
+  // The bound is (1 - Upsilon) max_recovery: the row keeps Upsilon of its speed from step to
+  // step (spook_rhs), so that its speed approaches max_recovery from below, where a bound of
+  // max_recovery itself gave (1 + 4 d) / (4 d) times it.
+  double gap_term(double gap, double ups, bool elastic = false, double penetration = 0.0) const
   {
-    const double term = -4.0 / h * ups * gap;
-    return !elastic && max_recovery > 0 && term > max_recovery ? max_recovery : term;
+    const double cap = (1.0 - ups) * max_recovery;
+    const auto bounded = [cap](double term) { return cap > 0 && term > cap ? cap : term; };
+    if (!elastic) return bounded(-4.0 / h * ups * gap);
+    if (!(penetration > 0)) return -4.0 / h * ups * gap;
+    return -4.0 / h * ups * (gap + penetration) + bounded(4.0 / h * ups * penetration);
   }
   double gap_term(double gap) const { return gap_term(gap, upsilon()); }
   // The same term of an elastic row's displacement, unbounded (the cone bounds the spring).
