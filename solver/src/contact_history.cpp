@@ -114,7 +114,9 @@ long ContactHistory::store(const std::vector<DetectedContact> &found, const Vect
     const DetectedContact &fc = found[c];
     const Contact &k = fc.contact;
     const double *l = lambda.data() + Eigen::Index(rows) * c;
-    if (!(l[0] > 0.0)) continue; // released: nothing to remember
+    // released: nothing to remember, but a penetration that opens faster than it must
+    const double penetration = springs ? (*springs)[c][0] : 0.0;
+    if (!(l[0] > 0.0) && !(penetration > 0.0)) continue;
     const Vec3 force = (l[0] * k.normal + l[1] * k.t1 + l[2] * k.t2) / h;
     Vec3 moment = Vec3::Zero();
     if (rows == 6) moment = (l[3] * k.normal + l[4] * k.t1 + l[5] * k.t2) / h;
@@ -126,13 +128,12 @@ long ContactHistory::store(const std::vector<DetectedContact> &found, const Vect
     double *slot = slots(s) + std::size_t(count_[s]++) * kSlotSize;
     slot[0] = fc.key;
     Vec3 tangential = Vec3::Zero(), rolling = Vec3::Zero();
-    double twisting = 0.0, penetration = 0.0;
+    double twisting = 0.0;
     if (springs) {
       const std::array<double, kMaxRows> &xi = (*springs)[c];
       tangential = xi[1] * k.t1 + xi[2] * k.t2;
       rolling = xi[4] * k.t1 + xi[5] * k.t2;
       twisting = xi[3];
-      penetration = xi[0];
     }
     for (int d = 0; d < 3; ++d) {
       slot[1 + d] = force[d];

@@ -63,7 +63,7 @@ void shorten_to_collision(const PairCoefficients &pc, const SpookParams &params,
 
 // Contact::penetration: the part of the overlap beyond what the contact's last load explains
 // (the law's overlap at that force) and the closing within a step (twice its approach speed's,
-// for the step's acceleration; nothing for a contact that opens), where it is more than
+// for the step's acceleration; as much where it opens: a bounce's overlap), where it is more than
 // max_recovery removes in a step. A penetration only shrinks with the overlap, whatever the
 // recovery's force; it is gone with it.
 void track_penetration(const PairCoefficients &pc, const SpookParams &params, double reff,
@@ -77,7 +77,7 @@ void track_penetration(const PairCoefficients &pc, const SpookParams &params, do
     c.penetration = std::min(c.penetration, overlap);
     return;
   }
-  const double explained = law_overlap(pc, reff, force) + 2.0 * params.h * std::max(approach, 0.0);
+  const double explained = law_overlap(pc, reff, force) + 2.0 * params.h * std::abs(approach);
   const double excess = overlap - explained;
   c.penetration = excess > params.h * params.max_recovery ? excess : 0.0;
 }
