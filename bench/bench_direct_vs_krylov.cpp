@@ -43,11 +43,11 @@
 #include <vector>
 
 #include "bench_scenes.hpp"
-#include "fibre/assembly.hpp"
-#include "fibre/direct.hpp"
-#include "fibre/krylov.hpp"
-#include "fibre/preconditioner_family.hpp"
-#include "fibre/system_io.hpp"
+#include "fibre/algebra/assembly.hpp"
+#include "fibre/io/system_io.hpp"
+#include "fibre/precond/preconditioner_family.hpp"
+#include "fibre/solvers/direct.hpp"
+#include "fibre/solvers/krylov.hpp"
 
 using namespace fibre;
 

@@ -16,10 +16,10 @@
 #include <vector>
 
 #include "bench_scenes.hpp"
-#include "fibre/accuracy_study.hpp"
-#include "fibre/nonsmooth_reference.hpp"
-#include "fibre/operators.hpp"
-#include "fibre/pgs.hpp"
+#include "fibre/algebra/operators.hpp"
+#include "fibre/solvers/pgs.hpp"
+#include "fibre/study/accuracy_study.hpp"
+#include "fibre/study/nonsmooth_reference.hpp"
 
 using namespace fibre;
 

@@ -16,8 +16,8 @@
 #include <thread>
 
 #include "bench_scenes.hpp"
-#include "fibre/operators.hpp"
-#include "fibre/preconditioner_family.hpp"
+#include "fibre/algebra/operators.hpp"
+#include "fibre/precond/preconditioner_family.hpp"
 
 using namespace fibre;
 

@@ -14,8 +14,8 @@
 #include <string>
 
 #include "bench_scenes.hpp"
-#include "fibre/operators.hpp"
-#include "fibre/preconditioner_family.hpp"
+#include "fibre/algebra/operators.hpp"
+#include "fibre/precond/preconditioner_family.hpp"
 
 using namespace fibre;
 

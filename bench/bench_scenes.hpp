@@ -17,8 +17,8 @@
 #include <random>
 #include <vector>
 
+#include "fibre/algebra/spook.hpp"
 #include "fibre/scenes.hpp"
-#include "fibre/spook.hpp"
 
 namespace fibre::bench {
 

@@ -26,7 +26,7 @@
 #include <vector>
 
 #include "bench_scenes.hpp"
-#include "fibre/operators.hpp"
+#include "fibre/algebra/operators.hpp"
 
 using namespace fibre;
 

@@ -9,8 +9,8 @@
 #include <string>
 
 #include "bench_scenes.hpp"
-#include "fibre/operators.hpp"
-#include "fibre/pgs.hpp"
+#include "fibre/algebra/operators.hpp"
+#include "fibre/solvers/pgs.hpp"
 
 using namespace fibre;
 

@@ -10,7 +10,7 @@
 #include <utility>
 #include <vector>
 
-#include "fibre/detection.hpp"
+#include "fibre/geometry/detection.hpp"
 #include "pointers.h"
 
 namespace fibre_lmp {

@@ -7,9 +7,9 @@
 #include "comm.h"
 #include "error.h"
 #include "host.h"
-#include "fibre/substeps.hpp"
-#include "fibre/system_io.hpp"
-#include "fibre/text.hpp"
+#include "fibre/core/text.hpp"
+#include "fibre/io/system_io.hpp"
+#include "fibre/step/substeps.hpp"
 #include "memory.h"
 #include "update.h"
 

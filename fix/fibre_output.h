@@ -6,11 +6,11 @@
 #include <string>
 #include <vector>
 
-#include "fibre/detection.hpp"
-#include "fibre/nonsmooth_reference.hpp"
-#include "fibre/spook.hpp"
-#include "fibre/step_solver.hpp"
-#include "fibre/stress.hpp"
+#include "fibre/algebra/spook.hpp"
+#include "fibre/geometry/detection.hpp"
+#include "fibre/model/stress.hpp"
+#include "fibre/step/step_solver.hpp"
+#include "fibre/study/nonsmooth_reference.hpp"
 #include "pointers.h"
 
 namespace fibre_lmp {

@@ -10,9 +10,9 @@
 #include <memory>
 #include <vector>
 
-#include "fibre/contact_history.hpp"
-#include "fibre/settings.hpp"
-#include "fibre/substeps.hpp"
+#include "fibre/frontend/settings.hpp"
+#include "fibre/model/contact_history.hpp"
+#include "fibre/step/substeps.hpp"
 #include "fix.h"
 
 namespace fibre_lmp {
@@ -93,6 +93,12 @@ class FixFibreContact : public Fix {
                   std::vector<fibre::Body> bodies, std::vector<fibre::Contact> contacts,
                   fibre::Vector warm);
   void update_velocities(const fibre::Vector *dv);
+  fibre::SpookParams step_params(const std::vector<fibre::Body> &bodies, double h) const;
+  fibre::Substeps solve_contacts(std::vector<fibre::Body> bodies,
+                                 const std::vector<fibre::DetectedContact> &found, int &substeps,
+                                 double &hs);
+  void report_step(const fibre::Substeps &steps, const std::vector<fibre::DetectedContact> &found,
+                   bool any, bool solved);
 
   fibre::Settings settings_;
   double dtv_ = 0.0;

@@ -12,7 +12,7 @@
 #include <unordered_map>
 #include <vector>
 
-#include "fibre/exchange.hpp"
+#include "fibre/core/exchange.hpp"
 #include "lmptype.h"
 
 namespace LAMMPS_NS {

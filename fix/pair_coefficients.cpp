@@ -5,7 +5,7 @@
 #include <cstring>
 
 #include "atom.h"
-#include "fibre/text.hpp"
+#include "fibre/core/text.hpp"
 #include "force.h"
 #include "host.h"
 #include "lammps.h"

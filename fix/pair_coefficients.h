@@ -15,7 +15,7 @@
 #include <string>
 #include <vector>
 
-#include "fibre/material.hpp"
+#include "fibre/model/material.hpp"
 #include "pointers.h"
 
 namespace fibre_lmp {

@@ -8,7 +8,7 @@
 
 #include "comm.h"
 #include "domain.h"
-#include "fibre/text.hpp"
+#include "fibre/core/text.hpp"
 #include "error.h"
 #include "fibre_detect.h"
 #include "host.h"

@@ -5,8 +5,8 @@
 
 #include <vector>
 
-#include "fibre/detection.hpp"
-#include "fibre/material.hpp"
+#include "fibre/geometry/detection.hpp"
+#include "fibre/model/material.hpp"
 #include "pointers.h"
 
 namespace fibre_lmp {

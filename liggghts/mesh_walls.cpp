@@ -11,7 +11,7 @@
 #include <string>
 
 #include "error.h"
-#include "fibre/mesh.hpp"
+#include "fibre/geometry/mesh.hpp"
 #include "fibre_detect.h"
 #include "fix_mesh_surface.h"
 #include "host.h"

@@ -9,11 +9,11 @@
 #include <string>
 #include <vector>
 
-#include "fibre/accuracy_study.hpp"
-#include "fibre/pgs.hpp"
-#include "fibre/settings.hpp"
-#include "fibre/spook.hpp"
-#include "fibre/text.hpp"
+#include "fibre/algebra/spook.hpp"
+#include "fibre/core/text.hpp"
+#include "fibre/frontend/settings.hpp"
+#include "fibre/solvers/pgs.hpp"
+#include "fibre/study/accuracy_study.hpp"
 
 using namespace fibre;
 

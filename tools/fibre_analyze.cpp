@@ -15,9 +15,9 @@
 #include <string>
 #include <vector>
 
-#include "fibre/analysis.hpp"
-#include "fibre/system_io.hpp"
-#include "fibre/text.hpp"
+#include "fibre/core/text.hpp"
+#include "fibre/io/system_io.hpp"
+#include "fibre/study/analysis.hpp"
 
 using namespace fibre;
 

@@ -7,7 +7,7 @@
 #include <stdexcept>
 #include <string_view>
 
-#include "fibre/system_io.hpp"
+#include "fibre/io/system_io.hpp"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t *data, std::size_t size)
 {

@@ -1,6 +1,6 @@
 #include "fibre/scenes.hpp"
 
-#include "fibre/spook.hpp"
+#include "fibre/algebra/spook.hpp"
 
 #include <algorithm>
 #include <cmath>

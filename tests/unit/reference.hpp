@@ -6,7 +6,7 @@
 #include <algorithm>
 #include <utility>
 
-#include "fibre/system.hpp"
+#include "fibre/core/system.hpp"
 
 namespace fibre::test {
 

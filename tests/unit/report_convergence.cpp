@@ -20,12 +20,12 @@
 #include <cstdio>
 #include <string>
 
-#include "fibre/spook.hpp"
-#include "fibre/direct.hpp"
-#include "fibre/krylov.hpp"
-#include "fibre/preconditioner_family.hpp"
+#include "fibre/algebra/spook.hpp"
+#include "fibre/algebra/spook.hpp"
+#include "fibre/precond/preconditioner_family.hpp"
 #include "fibre/scenes.hpp"
-#include "fibre/spook.hpp"
+#include "fibre/solvers/direct.hpp"
+#include "fibre/solvers/krylov.hpp"
 
 using namespace fibre;
 

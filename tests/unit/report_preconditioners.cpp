@@ -13,9 +13,9 @@
 #include <fstream>
 #include <string>
 
-#include "fibre/krylov.hpp"
-#include "fibre/preconditioner_family.hpp"
+#include "fibre/precond/preconditioner_family.hpp"
 #include "fibre/scenes.hpp"
+#include "fibre/solvers/krylov.hpp"
 
 using namespace fibre;
 

@@ -11,9 +11,9 @@
 #include <cmath>
 #include <cstdio>
 
-#include "fibre/preconditioner_family.hpp"
+#include "fibre/precond/preconditioner_family.hpp"
 #include "fibre/scenes.hpp"
-#include "fibre/spectra.hpp"
+#include "fibre/study/spectra.hpp"
 
 using namespace fibre;
 

@@ -6,10 +6,10 @@
 // more accurate, nonlinear CG beats plain sweeps at equal count.
 #include <gtest/gtest.h>
 
-#include "fibre/accuracy_study.hpp"
-#include "fibre/pgs.hpp"
-#include "fibre/settings.hpp"
-#include "fibre/system_io.hpp"
+#include "fibre/frontend/settings.hpp"
+#include "fibre/io/system_io.hpp"
+#include "fibre/solvers/pgs.hpp"
+#include "fibre/study/accuracy_study.hpp"
 #include "reference.hpp"
 
 #include <cstdio>

@@ -1,11 +1,11 @@
 // Explicit assembly against the independent dense references of reference.hpp.
 #include <gtest/gtest.h>
 
-#include "fibre/spook.hpp"
-#include "fibre/assembly.hpp"
-#include "fibre/kernels.hpp"
+#include "fibre/algebra/assembly.hpp"
+#include "fibre/algebra/kernels.hpp"
+#include "fibre/algebra/spook.hpp"
+#include "fibre/algebra/spook.hpp"
 #include "fibre/scenes.hpp"
-#include "fibre/spook.hpp"
 #include "reference.hpp"
 
 using namespace fibre;

@@ -5,7 +5,7 @@
 
 #include <cmath>
 
-#include "fibre/contact_history.hpp"
+#include "fibre/model/contact_history.hpp"
 
 using namespace fibre;
 

@@ -6,7 +6,7 @@
 #include <random>
 #include <tuple>
 
-#include "fibre/detection.hpp"
+#include "fibre/geometry/detection.hpp"
 
 using namespace fibre;
 

@@ -14,11 +14,11 @@
 #include <random>
 #include <string>
 
-#include "fibre/spook.hpp"
-#include "fibre/direct.hpp"
+#include "fibre/algebra/spook.hpp"
+#include "fibre/algebra/spook.hpp"
 #include "fibre/scenes.hpp"
-#include "fibre/spectra.hpp"
-#include "fibre/spook.hpp"
+#include "fibre/solvers/direct.hpp"
+#include "fibre/study/spectra.hpp"
 #include "reference.hpp"
 
 using namespace fibre;

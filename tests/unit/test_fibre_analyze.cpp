@@ -25,14 +25,14 @@
 #include <string>
 #include <vector>
 
-#include "fibre/analysis.hpp"
-#include "fibre/assembly.hpp"
-#include "fibre/krylov.hpp"
-#include "fibre/preconditioner_family.hpp"
+#include "fibre/algebra/assembly.hpp"
+#include "fibre/algebra/spook.hpp"
+#include "fibre/io/system_io.hpp"
+#include "fibre/precond/preconditioner_family.hpp"
 #include "fibre/scenes.hpp"
-#include "fibre/spectra.hpp"
-#include "fibre/spook.hpp"
-#include "fibre/system_io.hpp"
+#include "fibre/solvers/krylov.hpp"
+#include "fibre/study/analysis.hpp"
+#include "fibre/study/spectra.hpp"
 #include "reference.hpp"
 
 extern char **environ;

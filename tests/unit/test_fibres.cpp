@@ -7,9 +7,9 @@
 #include <map>
 #include <set>
 
-#include "fibre/fibres.hpp"
-#include "fibre/kernels.hpp"
-#include "fibre/operators.hpp"
+#include "fibre/algebra/kernels.hpp"
+#include "fibre/algebra/operators.hpp"
+#include "fibre/precond/fibres.hpp"
 #include "fibre/scenes.hpp"
 
 using namespace fibre;

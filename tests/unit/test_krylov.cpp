@@ -6,9 +6,9 @@
 #include <cmath>
 #include <limits>
 
-#include "fibre/krylov.hpp"
-#include "fibre/preconditioner_family.hpp"
+#include "fibre/precond/preconditioner_family.hpp"
 #include "fibre/scenes.hpp"
+#include "fibre/solvers/krylov.hpp"
 #include "reference.hpp"
 
 using namespace fibre;

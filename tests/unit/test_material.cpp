@@ -7,8 +7,8 @@
 #include <cmath>
 #include <tuple>
 
-#include "fibre/contact_model.hpp"
-#include "fibre/material.hpp"
+#include "fibre/model/contact_model.hpp"
+#include "fibre/model/material.hpp"
 #include "reference.hpp"
 
 using namespace fibre;

@@ -9,7 +9,7 @@
 #include <random>
 #include <vector>
 
-#include "fibre/mesh.hpp"
+#include "fibre/geometry/mesh.hpp"
 
 using namespace fibre;
 

@@ -3,10 +3,10 @@
 // answer of the active-set loop; step_accuracy measures by row group.
 #include <gtest/gtest.h>
 
-#include "fibre/nonsmooth_reference.hpp"
+#include "fibre/algebra/spook.hpp"
 #include "fibre/scenes.hpp"
-#include "fibre/spook.hpp"
-#include "fibre/step_solver.hpp"
+#include "fibre/step/step_solver.hpp"
+#include "fibre/study/nonsmooth_reference.hpp"
 #include "reference.hpp"
 
 using namespace fibre;

@@ -10,14 +10,14 @@
 #include <numeric>
 #include <utility>
 
-#include "fibre/apgd.hpp"
-#include "fibre/kernels.hpp"
-#include "fibre/nonsmooth_reference.hpp"
-#include "fibre/pgs.hpp"
+#include "fibre/algebra/kernels.hpp"
+#include "fibre/algebra/spook.hpp"
 #include "fibre/scenes.hpp"
-#include "fibre/spook.hpp"
-#include "fibre/step_solver.hpp"
-#include "fibre/sweep_groups.hpp"
+#include "fibre/solvers/apgd.hpp"
+#include "fibre/solvers/pgs.hpp"
+#include "fibre/solvers/sweep_groups.hpp"
+#include "fibre/step/step_solver.hpp"
+#include "fibre/study/nonsmooth_reference.hpp"
 #include "reference.hpp"
 
 using namespace fibre;

@@ -5,7 +5,7 @@
 
 #include <set>
 
-#include "fibre/preconditioner_family.hpp"
+#include "fibre/precond/preconditioner_family.hpp"
 #include "fibre/scenes.hpp"
 #include "reference.hpp"
 

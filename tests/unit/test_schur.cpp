@@ -1,11 +1,11 @@
 // The matrix-free Schur product and blocks against the dense thesis formula.
 #include <gtest/gtest.h>
 
-#include "fibre/spook.hpp"
-#include "fibre/kernels.hpp"
-#include "fibre/operators.hpp"
+#include "fibre/algebra/kernels.hpp"
+#include "fibre/algebra/operators.hpp"
+#include "fibre/algebra/spook.hpp"
+#include "fibre/algebra/spook.hpp"
 #include "fibre/scenes.hpp"
-#include "fibre/spook.hpp"
 #include "reference.hpp"
 
 using namespace fibre;

@@ -5,8 +5,8 @@
 
 #include <sstream>
 
-#include "fibre/settings.hpp"
-#include "fibre/text.hpp"
+#include "fibre/core/text.hpp"
+#include "fibre/frontend/settings.hpp"
 
 using namespace fibre;
 

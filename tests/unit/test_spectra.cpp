@@ -7,10 +7,10 @@
 #include <cmath>
 #include <random>
 
-#include "fibre/kernels.hpp"
-#include "fibre/preconditioner_family.hpp"
+#include "fibre/algebra/kernels.hpp"
+#include "fibre/precond/preconditioner_family.hpp"
 #include "fibre/scenes.hpp"
-#include "fibre/spectra.hpp"
+#include "fibre/study/spectra.hpp"
 #include "reference.hpp"
 
 using namespace fibre;

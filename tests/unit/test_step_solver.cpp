@@ -6,11 +6,11 @@
 #include <limits>
 #include <tuple>
 
-#include "fibre/material.hpp"
-#include "fibre/spook.hpp"
-#include "fibre/step_solver.hpp"
-#include "fibre/kernels.hpp"
+#include "fibre/algebra/kernels.hpp"
+#include "fibre/algebra/spook.hpp"
+#include "fibre/model/material.hpp"
 #include "fibre/scenes.hpp"
+#include "fibre/step/step_solver.hpp"
 #include "reference.hpp"
 
 using namespace fibre;

@@ -6,10 +6,10 @@
 #include <cmath>
 #include <vector>
 
-#include "fibre/contact_model.hpp"
-#include "fibre/spook.hpp"
-#include "fibre/step_solver.hpp"
-#include "fibre/substeps.hpp"
+#include "fibre/algebra/spook.hpp"
+#include "fibre/model/contact_model.hpp"
+#include "fibre/step/step_solver.hpp"
+#include "fibre/step/substeps.hpp"
 
 using namespace fibre;
 

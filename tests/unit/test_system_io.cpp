@@ -8,10 +8,10 @@
 #include <limits>
 #include <sstream>
 
-#include "fibre/spook.hpp"
+#include "fibre/algebra/spook.hpp"
+#include "fibre/algebra/spook.hpp"
+#include "fibre/io/system_io.hpp"
 #include "fibre/scenes.hpp"
-#include "fibre/spook.hpp"
-#include "fibre/system_io.hpp"
 #include "reference.hpp"
 
 using namespace fibre;

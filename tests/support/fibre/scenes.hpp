@@ -8,7 +8,7 @@
 #include <string>
 #include <vector>
 
-#include "fibre/system.hpp"
+#include "fibre/core/system.hpp"
 
 namespace fibre {
 

@@ -1,0 +1,63 @@
+#include "fibre/algebra/cones.hpp"
+
+#include <cmath>
+
+#include "fibre/algebra/kernels.hpp"
+#include "fibre/algebra/spook.hpp"
+
+namespace fibre {
+
+Cones::Cones(const ContactSystem &sys)
+    : rows_(sys.rows()), coeff_(std::size_t(sys.num_contacts()) * 3, 0.0)
+{
+  for (int c = 0; c < sys.num_contacts(); ++c) {
+    const FrictionParams &f = sys.contacts()[c].friction;
+    for (int k = 0; k < num_cones(rows_); ++k)
+      coeff_[3 * std::size_t(c) + k] = cone_coefficient(f, sys.effective_radius(c), k);
+  }
+}
+
+std::vector<Vec6> row_scales(const ContactSystem &sys)
+{
+  std::vector<Vec6> diagonal(sys.num_contacts());
+  for (int c = 0; c < sys.num_contacts(); ++c) diagonal[c] = diagonal_entries(sys, c);
+  return row_scales(diagonal, sys.rows());
+}
+
+std::vector<Vec6> row_scales(const std::vector<Vec6> &diagonal, int rows)
+{
+  const int nc = static_cast<int>(diagonal.size());
+  std::vector<Vec6> scale(nc, Vec6::Ones());
+  for (int c = 0; c < nc; ++c) {
+    const Vec6 &D = diagonal[c];
+    scale[c][0] = D[0];
+    for (int k = 0; k < num_cones(rows); ++k) {
+      const Cone &cone = kCones[k];
+      double d = D[cone.first];
+      if (cone.size == 2) d = std::max(d, D[cone.first + 1]);
+      for (int i = 0; i < cone.size; ++i) scale[c][cone.first + i] = d;
+    }
+  }
+  return scale;
+}
+
+double complementarity(const ContactSystem &sys, const Exchange &ex, const Cones &cones,
+                       const Vector &b, const Vector &lambda, const std::vector<Vec6> &scale)
+{
+  const int rows = sys.rows();
+  Vector G_dv;
+  g_apply(sys, velocity_change(sys, ex, lambda), G_dv);
+  const Vector rho = b - G_dv - sys.sigma().cwiseProduct(lambda);
+  Vector trial = lambda;
+  for (int c = 0; c < sys.num_contacts(); ++c)
+    for (int i = 0; i < rows; ++i)
+      trial[Eigen::Index(rows) * c + i] += rho[Eigen::Index(rows) * c + i] / scale[c][i];
+  for (int c = 0; c < sys.num_contacts(); ++c)
+    cones.project(trial.data() + Eigen::Index(rows) * c, c);
+  double sums[2] = {(trial - lambda).squaredNorm(), lambda.squaredNorm()};
+  ex.sum(sums, 2);
+  if (!(sums[1] > 0)) return sums[0] > 0 ? 1.0 : 0.0;
+  return std::sqrt(sums[0] / sums[1]);
+}
+
+} // namespace fibre

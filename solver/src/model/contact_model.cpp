@@ -1,0 +1,230 @@
+#include "fibre/model/contact_model.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+namespace fibre {
+
+double cone_coefficient(const FrictionParams &f, double r_eff, int cone)
+{
+  if (cone == 0) return f.mu;
+  return (cone == 1 ? f.mu_twist : f.mu_roll) * r_eff;
+}
+
+namespace {
+
+// The contact's reduced mass (the sphere's against a wall).
+double effective_mass(const std::vector<Body> &bodies, const Contact &c)
+{
+  const double ma = bodies[c.a].mass;
+  return c.is_wall() ? ma : ma * bodies[c.b].mass / (ma + bodies[c.b].mass);
+}
+
+} // namespace
+
+double normal_approach(const std::vector<Body> &bodies, const Contact &c)
+{
+  const Vec3 vb = c.is_wall() ? c.wall_v : bodies[c.b].v;
+  return -(bodies[c.a].v - vb).dot(c.normal);
+}
+
+Vec3 relative_velocity(const std::vector<Body> &bodies, const Contact &c)
+{
+  const Body &a = bodies[c.a];
+  const Vec3 va = a.v + a.omega.cross(c.point - a.x);
+  if (c.is_wall()) return va - c.wall_v;
+  const Body &b = bodies[c.b];
+  return va - (b.v + b.omega.cross(c.point - b.x));
+}
+
+namespace {
+
+// Contact c's coefficients from its type pair's (pc), and with compliance material its rows'
+// compliances, springs and damping.
+// A contact that bounces within the step touches for the law's collision time t_c only, at a
+// large step and a stiff material a fraction phi = t_c / h of the step: its springs and
+// dampers act for t_c (stiffness phi^2 k and damping phi gamma give the collision's impulses
+// k t_c^2 and gamma t_c). Over the whole step they took 1 / phi times the rolling resistance of
+// every bounce (doc/design.md, session 16). d is the rows' damping (steps) so far.
+void shorten_to_collision(const PairCoefficients &pc, const SpookParams &params, double reff,
+                          double m_eff, double approach, double d, int rows, Contact &c)
+{
+  const bool bounces =
+      c.restitution > 0 && approach > params.bounce_speed && c.gap <= params.h * approach;
+  if (!bounces) return;
+  const double phi = collision_time(pc, reff, m_eff, approach) / params.h;
+  if (!(phi > 0 && phi < 1)) return;
+  for (int r = 1; r < rows; ++r)
+    if (c.elastic[r]) {
+      c.compliance[r] /= phi * phi;
+      c.spring_damping[r] = (c.spring_damping[r] >= 0 ? c.spring_damping[r] : d) / phi;
+    }
+}
+
+// Contact::penetration: the part of the overlap beyond what the contact's last load explains
+// (the law's overlap at that force) and the closing within a step (twice its approach speed's,
+// for the step's acceleration; as much where it opens: a bounce's overlap), where it is more than
+// max_recovery removes in a step. A penetration only shrinks with the overlap, whatever the
+// recovery's force; it is gone with it.
+void track_penetration(const PairCoefficients &pc, const SpookParams &params, double reff,
+                       double overlap, double force, double approach, Contact &c)
+{
+  if (!(params.max_recovery > 0)) {
+    c.penetration = 0.0;
+    return;
+  }
+  if (c.penetration > 0) {
+    c.penetration = std::min(c.penetration, overlap);
+    return;
+  }
+  const double explained = law_overlap(pc, reff, force) + 2.0 * params.h * std::abs(approach);
+  const double excess = overlap - explained;
+  c.penetration = excess > params.h * params.max_recovery ? excess : 0.0;
+}
+
+void apply_pair(const ContactModel &model, const PairCoefficients &pc, const SpookParams &params,
+                double reff, const std::vector<Body> &bodies, double last_normal, Contact &c)
+{
+  const double h = params.h;
+  const double overlap = std::max(-c.gap, 0.0);
+  const FrictionParams f = contact_friction(pc, reff, overlap);
+  const TypedCoefficients &typed = model.typed;
+  if (!typed.mu) c.friction.mu = f.mu;
+  if (!typed.mu_roll) c.friction.mu_roll = f.mu_roll;
+  if (!typed.mu_twist) c.friction.mu_twist = f.mu_twist;
+  if (!typed.restitution && pc.restitution >= 0) c.restitution = pc.restitution;
+  if (!model.compliance.material) return;
+  // a viscous dashpot's rebound depends on the impact: its masses, radii and approach speed
+  // (the law's; under compliance auto the gran/* styles' kn is no material)
+  if (!typed.restitution && pc.restitution < 0 && last_normal == 0) {
+    const double reach = bodies[c.a].radius + (c.is_wall() ? 0.0 : bodies[c.b].radius);
+    const double e =
+        viscous_restitution(pc, effective_mass(bodies, c), reff, normal_approach(bodies, c), reach);
+    if (e >= 0) c.restitution = e;
+  }
+  const int rows = model.rows;
+  const double force = last_normal / h;
+  track_penetration(pc, params, reff, overlap, force, normal_approach(bodies, c), c);
+  const std::array<double, kMaxRows> rigid = c.compliance;
+  // A penetration's row keeps the law's compliance at its overlap (its last force was the
+  // recovery's), so that it leaves no faster than the law's spring would push it: a soft
+  // material's overlap is removed slower than the recovery speed, as native's is.
+  material_compliance(pc, reff, overlap, c.penetration > 0 ? 0.0 : force, rigid, c.compliance,
+                      c.elastic);
+  for (int r = rows; r < kMaxRows; ++r) c.elastic[r] = false;
+  // A loaded contact's normal row is a Kelvin-Voigt element with the law's own dashpot (damping
+  // time gamma_n / k), at least SPOOK's d, below which a contact stiffer than the step rings
+  // (normal_relaxation spook, the default; law: see the end of this function). A
+  // law without a dashpot is damped critically, tau = 2 sqrt(m_eff eps). Its springs keep at
+  // least that critical damping (below). Bounces come from e (doc/design.md, session 17).
+  const double m_eff = effective_mass(bodies, c);
+  double critical = 0.0;   // the normal row's, in steps
+  double tau_n = INFINITY; // the normal row's damping time (seconds): the law's dashpot
+  if (c.elastic[0]) {
+    const double eps = c.compliance[0];
+    const double gamma_n = normal_damper(pc, m_eff, std::sqrt(reff * overlap), 1.0 / eps);
+    critical = 2.0 * std::sqrt(m_eff * eps) / h;
+    tau_n = gamma_n >= 0 ? gamma_n * eps : critical * h;
+    if (tau_n / h > model.damping) c.damping = tau_n / h;
+  }
+  // The springs take at least the contact's damping and the normal row's critical damping:
+  // below it a pile at rest rocks on its rolling springs (session 15), and a sphere that a
+  // bowl's rolling resistance stops rolls back up (session 17). The SDS rolling and twisting
+  // springs carry the law's own damper (SPOOK's damping time is the Kelvin-Voigt element's
+  // gamma / k) where that is longer (doc/design.md, session 15).
+  const double contact_d = std::max(model.damping, c.damping);
+  const double floor = std::max(contact_d, critical);
+  for (int r = 1; r <= 2 && r < rows; ++r)
+    if (c.elastic[r] && floor > contact_d) c.spring_damping[r] = floor;
+  for (int r = 3; r < rows; ++r) {
+    const double tau = spring_damping_time(pc, r);
+    if (c.elastic[r] && tau > 0) {
+      c.spring_damping[r] = std::max(floor, tau / h);
+      c.damper_time[r] = tau;
+    }
+  }
+  if (force == 0) // an impact, unless it approaches too slowly
+    shorten_to_collision(pc, params, reff, m_eff, normal_approach(bodies, c), floor, rows, c);
+  // normal_relaxation law: where SPOOK would floor the law's dashpot at `damping` steps (a
+  // stiff flow's enduring contacts then relaxed over 2 h, many times the law's time:
+  // examples/README.md, "The constraints' relaxation time at a large step"), the normal row is
+  // the law's spring and dashpot by implicit Euler, which does not ring. Where the dashpot is
+  // longer SPOOK resolves the law's swing (ContactSolver.LoadedHertzContactSwingsAsTheDampedLaw)
+  // and implicit Euler would damp it. The other rows keep the contact's SPOOK damping.
+  if (model.normal_relaxation == NormalRelaxation::law && c.elastic[0] &&
+      tau_n < model.damping * h) {
+    const double kept = params.damping_of(c);
+    for (int r = 1; r < rows; ++r)
+      if (c.spring_damping[r] < 0) c.spring_damping[r] = kept;
+    c.damping = 0.75 + tau_n / h;
+    c.implicit_normal = true;
+  }
+}
+
+} // namespace
+
+void apply_contact_model(const ContactModel &model, const SpookParams &params, double m_min,
+                         const std::vector<Body> &bodies, std::vector<Contact> &contacts,
+                         const Vector *last, const std::vector<double> *r_eff)
+{
+  const double h = params.h;
+  const ComplianceParams &p = model.compliance;
+  double eps_n = p.eps_n, eps_t = p.eps_t;
+  if (p.automatic || p.material) eps_n = eps_t = p.factor * h * h / m_min;
+  for (std::size_t k = 0; k < contacts.size(); ++k) {
+    Contact &c = contacts[k];
+    const double reff = r_eff ? (*r_eff)[k] : effective_radius(bodies, c);
+    c.compliance[0] = eps_n;
+    c.compliance[1] = c.compliance[2] = eps_t;
+    for (int r = 3; r < kMaxRows; ++r) c.compliance[r] = eps_t / (reff * reff);
+    c.friction = model.friction;
+    c.restitution = model.restitution;
+    c.elastic.fill(false);
+    c.implicit_normal = false;
+    c.damping = -1.0;
+    c.spring_damping.fill(-1.0);
+    c.damper_time.fill(0.0);
+    // The last normal impulse, none at round-off: a converged substep leaves 1e-16 where a
+    // contact's trial impulse is zero, and such a load made the contact an enduring one,
+    // without restitution and with the compliance of a vanishing load (0.1 where the rigid
+    // row's is 1e-8), so that one impact bounced by Newton's law in the run and by the law's
+    // spring in the converged step (session 42).
+    const Eigen::Index normal = Eigen::Index(model.rows) * Eigen::Index(k);
+    double last_normal = last && last->size() > normal ? std::max((*last)[normal], 0.0) : 0.0;
+    const double speed = std::abs(normal_approach(bodies, c)) + params.bounce_speed;
+    if (last_normal <= kRoundoffLoad * effective_mass(bodies, c) * speed) last_normal = 0.0;
+    const int ta = bodies[c.a].type;
+    const int tb = !c.is_wall() ? bodies[c.b].type : c.wall_type > 0 ? c.wall_type : ta;
+    const int ntypes = model.materials.ntypes();
+    if (model.per_type() && ta >= 1 && tb >= 1 && ta <= ntypes && tb <= ntypes)
+      apply_pair(model, model.materials.at(ta, tb), params, reff, bodies, last_normal, c);
+    // An impact is a contact that carried no load in the last step; an enduring one does not
+    // bounce (without external forces bounce_speed is 0, and Newton's law on every contact of
+    // a sheared pack threw its grains out of the cell).
+    if (last_normal > 0.0) c.restitution = 0.0;
+    // a spring's displacement lives on elastic rows only
+    for (int r = 0; r < kMaxRows; ++r)
+      if (!c.elastic[r]) c.spring[r] = 0.0;
+  }
+}
+
+bool ContactModel::may_bounce() const
+{
+  if (restitution > 0) return true;
+  if (!per_type() || typed.restitution) return false;
+  for (int i = 1; i <= materials.ntypes(); ++i)
+    for (int j = i; j <= materials.ntypes(); ++j)
+      if (materials.at(i, j).restitution > 0 ||
+          (compliance.material && materials.at(i, j).viscous != ViscousDamping::none))
+        return true; // a viscous law rebounds under compliance material only (apply_pair)
+  return false;
+}
+
+double external_speed_per_step(const std::vector<Body> &bodies, int num_owned, double h)
+{
+  double v = 0.0;
+  for (int i = 0; i < num_owned; ++i) v = std::max(v, h * bodies[i].force.norm() / bodies[i].mass);
+  return v;
+}
+
+} // namespace fibre
