@@ -233,41 +233,31 @@ std::size_t read_solver_keyword(const Reader &in, std::size_t i, StepOptions &op
 }
 
 // The contact model's keywords (friction included); 0 when `key` is not one of them.
-std::size_t read_model_keyword(const Reader &in, std::size_t i, Settings &s)
+// compliance auto|material|<eps_n> <eps_t>
+std::size_t read_compliance(const Reader &in, std::size_t i, Settings &s)
+{
+  const std::string e =
+      "'compliance auto|material' or 'compliance <eps_n> <eps_t>' (positive numbers)";
+  if (!in.has(i + 1)) Reader::illegal(e);
+  s.model.typed.compliance = true;
+  if (in.at(i + 1) == "auto" || in.at(i + 1) == "material") {
+    s.model.compliance.automatic = true;
+    s.model.compliance.material = in.at(i + 1) == "material";
+    return 2;
+  }
+  const double en = in.positive(i + 1, e);
+  const double et = in.positive(i + 2, e);
+  s.model.compliance.automatic = false;
+  s.model.compliance.material = false;
+  s.model.compliance.eps_n = en;
+  s.model.compliance.eps_t = et;
+  return 3;
+}
+
+// recovery_speed and bounce_speed: auto, a speed (recovery_speed also none)
+std::size_t read_speed_keyword(const Reader &in, std::size_t i, Settings &s)
 {
   const std::string &key = in.at(i);
-  if (key == "compliance") {
-    const std::string e =
-        "'compliance auto|material' or 'compliance <eps_n> <eps_t>' (positive numbers)";
-    if (!in.has(i + 1)) Reader::illegal(e);
-    s.model.typed.compliance = true;
-    if (in.at(i + 1) == "auto" || in.at(i + 1) == "material") {
-      s.model.compliance.automatic = true;
-      s.model.compliance.material = in.at(i + 1) == "material";
-      return 2;
-    }
-    const double en = in.positive(i + 1, e);
-    const double et = in.positive(i + 2, e);
-    s.model.compliance.automatic = false;
-    s.model.compliance.material = false;
-    s.model.compliance.eps_n = en;
-    s.model.compliance.eps_t = et;
-    return 3;
-  }
-  if (key == "damping") {
-    s.model.damping = in.positive(i + 1, "'damping <positive number of steps>'");
-    return 2;
-  }
-  if (key == "mu" || key == "mu_roll" || key == "mu_twist") {
-    const std::string e = "'" + key + " <non-negative number>'";
-    const double v = in.number(i + 1, e);
-    if (!(v >= 0.0)) Reader::illegal(e, &in.at(i + 1));
-    FrictionParams &f = s.model.friction;
-    TypedCoefficients &typed = s.model.typed;
-    (key == "mu" ? f.mu : key == "mu_roll" ? f.mu_roll : f.mu_twist) = v;
-    (key == "mu" ? typed.mu : key == "mu_roll" ? typed.mu_roll : typed.mu_twist) = true;
-    return 2;
-  }
   if (key == "recovery_speed") {
     const std::string e = "'recovery_speed auto|none|<positive speed>'";
     if (!in.has(i + 1)) Reader::illegal(e);
@@ -278,22 +268,6 @@ std::size_t read_model_keyword(const Reader &in, std::size_t i, Settings &s)
       s.model.recovery_speed = 0.0;
     else
       s.model.recovery_speed = in.positive(i + 1, e);
-    return 2;
-  }
-  if (key == "restitution") {
-    const std::string e = "'restitution <number in [0, 1]>'";
-    const double v = in.number(i + 1, e);
-    if (!(v >= 0.0 && v <= 1.0)) Reader::illegal(e, &in.at(i + 1));
-    s.model.restitution = v;
-    s.model.typed.restitution = true;
-    return 2;
-  }
-  if (key == "coefficients") {
-    s.model.coefficients = in.name<CoefficientSource>(i + 1, key);
-    return 2;
-  }
-  if (key == "normal_relaxation") {
-    s.model.normal_relaxation = in.name<NormalRelaxation>(i + 1, key);
     return 2;
   }
   if (key == "bounce_speed") {
@@ -308,6 +282,13 @@ std::size_t read_model_keyword(const Reader &in, std::size_t i, Settings &s)
     s.model.bounce_speed = v;
     return 2;
   }
+  return 0;
+}
+
+// substeps, substep_when, substep_collisions
+std::size_t read_substep_keyword(const Reader &in, std::size_t i, Settings &s)
+{
+  const std::string &key = in.at(i);
   if (key == "substeps") {
     const std::string e = "'substeps auto|<integer 1 to " + std::to_string(kMaxSubsteps) + ">'";
     if (!in.has(i + 1)) Reader::illegal(e);
@@ -325,6 +306,46 @@ std::size_t read_model_keyword(const Reader &in, std::size_t i, Settings &s)
   if (key == "substep_collisions") {
     s.model.substep_collisions =
         in.positive(i + 1, "'substep_collisions <positive number of collision times>'");
+    return 2;
+  }
+  return 0;
+}
+
+std::size_t read_model_keyword(const Reader &in, std::size_t i, Settings &s)
+{
+  const std::string &key = in.at(i);
+  if (key == "compliance") return read_compliance(in, i, s);
+  if (key == "recovery_speed" || key == "bounce_speed") return read_speed_keyword(in, i, s);
+  if (key == "substeps" || key == "substep_when" || key == "substep_collisions")
+    return read_substep_keyword(in, i, s);
+  if (key == "damping") {
+    s.model.damping = in.positive(i + 1, "'damping <positive number of steps>'");
+    return 2;
+  }
+  if (key == "mu" || key == "mu_roll" || key == "mu_twist") {
+    const std::string e = "'" + key + " <non-negative number>'";
+    const double v = in.number(i + 1, e);
+    if (!(v >= 0.0)) Reader::illegal(e, &in.at(i + 1));
+    FrictionParams &f = s.model.friction;
+    TypedCoefficients &typed = s.model.typed;
+    (key == "mu" ? f.mu : key == "mu_roll" ? f.mu_roll : f.mu_twist) = v;
+    (key == "mu" ? typed.mu : key == "mu_roll" ? typed.mu_roll : typed.mu_twist) = true;
+    return 2;
+  }
+  if (key == "restitution") {
+    const std::string e = "'restitution <number in [0, 1]>'";
+    const double v = in.number(i + 1, e);
+    if (!(v >= 0.0 && v <= 1.0)) Reader::illegal(e, &in.at(i + 1));
+    s.model.restitution = v;
+    s.model.typed.restitution = true;
+    return 2;
+  }
+  if (key == "coefficients") {
+    s.model.coefficients = in.name<CoefficientSource>(i + 1, key);
+    return 2;
+  }
+  if (key == "normal_relaxation") {
+    s.model.normal_relaxation = in.name<NormalRelaxation>(i + 1, key);
     return 2;
   }
   if (key == "rows") {
