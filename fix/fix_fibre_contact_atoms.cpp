@@ -7,47 +7,13 @@
 #include "fix_fibre_contact.h"
 
 #include <algorithm>
-#include <cmath>
-#include <exception>
-#include <limits>
-#include <string>
-#include <vector>
-#if defined(__GLIBC__)
-#include <malloc.h>
-#endif
 
 #include "atom.h"
-#include "comm.h"
-#include "compute.h"
-#include "domain.h"
-#include "error.h"
-#include "fibre_detect.h"
-#include "fibre/algebra/spook.hpp"
-#include "fibre/core/text.hpp"
-#include "fibre/model/stress.hpp"
-#include "fibre/step/substeps.hpp"
-#include "fibre/study/nonsmooth_reference.hpp"
 #include "fibre_output.h"
-#include "pair_coefficients.h"
-#include "deck_models.h"
-#include "wall_materials.h"
-#include "force.h"
-#include "group.h"
 #include "host.h"
 #include "lammps_exchange.h"
-#include "modify.h"
-#include "neighbor.h"
-#include "pair.h"
-#include "update.h"
 
 using namespace LAMMPS_NS;
-using namespace FixConst;
-using fibre_lmp::fail;
-using fibre_lmp::fail_one;
-using fibre_lmp::FibreOutput;
-using fibre_lmp::logmesg;
-using fibre_lmp::starts_with;
-using fibre_lmp::warn;
 
 /* ----------------------------------------------------------------------
    per-atom warm-start storage: fibre::ContactHistory
