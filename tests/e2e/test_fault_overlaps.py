@@ -21,16 +21,19 @@ import fibre_e2e as e2e
 
 LAW = "hertz/material {E} 0.3 0.3 tangential mindlin NULL 1.0 0.5 damping tsuji"
 
-PAIR = "units si\n" + "\n".join(e2e.sphere_box("-2 2 -2 2 -2 2", processors="{procs}")) + """
-create_atoms 1 single -0.4 0 0 units box
-create_atoms 1 single {xb} 0 0 units box
-set atom * diameter 1.0 density 2500
+# the spheres' material, the step and the fix of the pair and wall decks
+SPHERES = """set atom * diameter 1.0 density 2500
 pair_style granular
 pair_coeff * * """ + LAW + """
 neighbor 0.2 bin
 timestep 1e-3
 {fix}
-compute vmax all reduce max vx
+"""
+
+PAIR = "units si\n" + "\n".join(e2e.sphere_box("-2 2 -2 2 -2 2", processors="{procs}")) + """
+create_atoms 1 single -0.4 0 0 units box
+create_atoms 1 single {xb} 0 0 units box
+""" + SPHERES + """compute vmax all reduce max vx
 compute vmin all reduce min vx
 thermo_style custom step atoms c_vmax c_vmin
 thermo_modify lost warn format float %.15g
@@ -40,13 +43,7 @@ run 60
 
 WALL = "units si\n" + "\n".join(e2e.sphere_box("-2 2 -2 2 -1 3")) + """
 create_atoms 1 single 0 0 {z0} units box
-set atom * diameter 1.0 density 2500
-pair_style granular
-pair_coeff * * """ + LAW + """
-neighbor 0.2 bin
-timestep 1e-3
-{fix}
-variable vz equal vz[1]
+""" + SPHERES + """variable vz equal vz[1]
 thermo_style custom step atoms v_vz
 thermo_modify lost warn format float %.15g
 thermo 1

@@ -48,6 +48,18 @@ Body sphere(double mass, double radius, const Vec3 &x)
   return b;
 }
 
+// compliance material with one type of this law, three rows
+ContactModel material_model(const PairCoefficients &law)
+{
+  ContactModel model;
+  model.compliance.automatic = false;
+  model.compliance.material = true;
+  model.rows = 3;
+  model.materials = MaterialTable(1);
+  model.materials.at(1, 1) = law;
+  return model;
+}
+
 // The settings these tests were written for (the library's defaults before they moved to the
 // measured ones of the fix): MINRES, block preconditioner, linear_tol 1e-6, 5 passes.
 StepOptions base_options()
@@ -421,12 +433,7 @@ TEST(ContactSolver, LoadedHertzContactSwingsAsTheDampedLaw)
     if (dd > 0 && ref_min == INFINITY) ref_max = std::max(ref_max, d);
     if (dd <= 0 || ref_min < INFINITY) ref_min = std::min(ref_min, d);
   }
-  ContactModel model;
-  model.compliance.automatic = false;
-  model.compliance.material = true;
-  model.rows = 3;
-  model.materials = MaterialTable(1);
-  model.materials.at(1, 1) = law;
+  const ContactModel model = material_model(law);
   std::vector<Body> bodies{sphere(m, r, Vec3(0, 0, r - d_eq))};
   bodies[0].type = 1;
   bodies[0].v.z() = -v0;
@@ -529,12 +536,7 @@ DeepStart deep_start(double v_rec, int steps)
   law.set = true;
   law.normal = NormalLaw::hertz_material;
   law.k_n = 5e8;
-  ContactModel model;
-  model.compliance.automatic = false;
-  model.compliance.material = true;
-  model.rows = 3;
-  model.materials = MaterialTable(1);
-  model.materials.at(1, 1) = law;
+  const ContactModel model = material_model(law);
   SpookParams params = spook();
   params.max_recovery = v_rec;
   StepOptions o = base_options();
