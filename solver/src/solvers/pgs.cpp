@@ -366,275 +366,372 @@ std::vector<std::vector<int>> colour_phases(const ContactSystem &sys, const Exch
   return phases;
 }
 
+// One call of pgs: the sweeps' process layout and masses, their groups, Anderson's history and
+// the stop and stall rules over the sweeps of one solve.
+class PgsRun {
+ public:
+  PgsRun(const ContactSystem &sys, const Exchange &ex, const Cones &cones, const Vector &b,
+         const std::vector<Vec6> &scale, Vector &lambda, const PgsControl &control)
+      : sys_(sys), ex_(ex), cones_(cones), b_(b), control_(control), lambda_(lambda),
+        nc_(sys.num_contacts()), rows_(sys.rows()), halo_(ex.has_halo()),
+        // the blocks' corrections are not part of the sweeps' steps, and measured with them
+        // the combination diverged on a stiff pile: plain sweeps only
+        accelerate_(control.anderson > 0 && !control.nonlinear_cg && !control.fibre_blocks),
+        focus_(control.focus_sweeps > 0 && !control.nonlinear_cg && !control.fibre_blocks &&
+               !accelerate_),
+        anderson_(std::max(control.anderson, 1), ex), period_(std::max(control.anderson_period, 1))
+  {
+    layout(scale);
+    // the blocks read their bound rows from feasible impulses
+    if (control_.fibre_blocks)
+      for (int c = 0; c < nc_; ++c) cones_.project(lambda_.data() + Eigen::Index(rows_) * c, c);
+    dv_ = velocity_change(sys_, ex_, lambda_);
+    // Each phase's changes go to the other processes as `moved_`, from dv_start_, its start: on
+    // the halo's bodies only where it names them (a few dozen, where a full vector has every
+    // ghost).
+    halo_bodies_ = halo_ ? copies_->bodies() : nullptr;
+    if (halo_) {
+      dv_start_ = dv_;
+      moved_ = Vector::Zero(dv_.size());
+    }
+    if (control_.fibre_blocks) {
+      Vector normal(nc_);
+      for (int c = 0; c < nc_; ++c) normal[c] = lambda_[Eigen::Index(rows_) * c];
+      blocks_ = std::make_unique<FibreBlocks>(sys_, ex_.local_owners(), cones_,
+                                              control_.block_weight, &normal);
+    }
+    grouped_ = control_.cache ? &control_.cache->grouped : &own_;
+    prepare_groups();
+    contact_changes_.resize(focus_ ? nc_ : 0);
+  }
+
+  PgsResult run()
+  {
+    for (int s = 0; s < control_.max_sweeps; ++s)
+      if (sweep(s)) {
+        if (res_.reason == StopReason::non_finite) return res_; // lambda is the checkpoint
+        break;
+      }
+    if (combination_) lambda_ = anderson_.sweep_result();
+    if (control_.nonlinear_cg) // the last step along the direction may have left the cones
+      for (int c = 0; c < nc_; ++c) cones_.project(lambda_.data() + Eigen::Index(rows_) * c, c);
+    return res_;
+  }
+
+ private:
+  // Impulses to fall back on when a sweep turns non-finite: a copy every kCheckpointSweeps
+  // sweeps, not every sweep (stiff steps take hundreds), and every sweep for nonlinear CG,
+  // whose direction is the sweep's change.
+  static constexpr int kCheckpointSweeps = 16;
+
+  void layout(const std::vector<Vec6> &scale);
+  void prepare_groups();
+  void keep_start();
+  void sweep_and_sum(const int *visit, int n, GroupedSweep *group, double *norms, double *changes);
+  bool sweep(int s);
+  bool stop_rule(bool full, const double *norms);
+  bool stalled();
+  void cg_step(int s, double change2);
+
+  const ContactSystem &sys_;
+  const Exchange &ex_;
+  const Cones &cones_;
+  const Vector &b_;
+  const PgsControl &control_;
+  Vector &lambda_;
+  PgsResult res_;
+  const int nc_, rows_;
+  const bool halo_; // else the round trip of the sweeps' changes is the identity
+  const bool accelerate_, focus_;
+  // the process layout (layout())
+  std::unique_ptr<Exchange::Halo> copies_;
+  BodyShares shares_;
+  std::vector<std::vector<int>> phases_;
+  bool coloured_ = false;
+  Vector split_inv_mass_;
+  std::vector<Vec6> inv_scale_;
+  const double *inv_mass_ = nullptr;
+  // the sweeps' velocity change, and its exchange
+  Vector dv_, dv_start_, moved_;
+  const std::vector<int> *halo_bodies_ = nullptr;
+  Vector lambda_start_;
+  double best_ = INFINITY;
+  int since_best_ = 0;
+  // Anderson's combination can cycle where plain sweeps converge (a LIGGGHTS heap's step: its
+  // rotations drifted off again after sweep 900). After kAndersonStallSweeps sweeps without a
+  // new smallest change the sweeps go on plain from the best checkpointed sweep.
+  bool plain_ = false, have_best_ = false; // have_best_: alike on every process
+  Vector lambda_best_;
+  Vector direction_, change_; // nonlinear CG
+  double last_change2_ = 0;
+  std::unique_ptr<FibreBlocks> blocks_;
+  std::vector<std::unique_ptr<GroupedSweep>> own_;
+  std::vector<std::unique_ptr<GroupedSweep>> *grouped_ = nullptr;
+  Anderson anderson_;
+  const int period_;
+  bool combination_ = false; // lambda is Anderson's start, not a sweep's result
+  std::vector<double> contact_changes_;
+  std::vector<int> focus_contacts_;
+};
+
+// Two process colours (Exchange::Halo::colours): the contacts on bodies that other processes'
+// contacts move too are swept in their process's colour's phase of the sweep, so that a body
+// that processes of two colours share moves as on one process. A body that processes of one
+// colour share (all of them without colours) is split among them: each sees a copy of inverse
+// mass split / m (mass splitting). Neither with fibre blocks, whose corrections move their
+// bodies at their own mass, nor with nonlinear CG, whose steps along its direction the split
+// slowed (12 of test_fix_solvers' 60 steps at np 2 unconverged); focused sweeps split only.
+void PgsRun::layout(const std::vector<Vec6> &scale)
+{
+  const std::vector<char> touched = halo_ ? touched_bodies(sys_, ex_) : std::vector<char>();
+  const bool shareable = halo_ && !control_.fibre_blocks && !control_.nonlinear_cg;
+  const bool colouring = shareable && !focus_;
+  copies_ = halo_ ? ex_.halo(touched, colouring) : nullptr;
+  // (the counts per colour travel in a body's kBodyDofs entries)
+  const int colours = colouring && copies_->colours() <= kBodyDofs ? copies_->colours() : 1;
+  const int colour = colours > 1 ? copies_->colour() : 0;
+  shares_ = shareable ? body_shares(touched, ex_, colours, colour) : BodyShares();
+  const Vector &split = shares_.split;
+  if (colours > 1 && shares_.total.size())
+    phases_ = colour_phases(sys_, ex_, shares_.total, colours, colour);
+  coloured_ = !phases_.empty();
+  inv_scale_.resize(scale.size());
+  if (split.size()) {
+    split_inv_mass_ = sys_.inv_mass().cwiseProduct(split);
+    const std::vector<int> &owners = ex_.local_owners();
+    const auto split_of = [&](int body) {
+      if (body < 0) return 1.0;
+      return split[Eigen::Index(kBodyDofs) * owner_of(owners, body)];
+    };
+    std::vector<Vec6> diagonal(nc_);
+    for (int c = 0; c < nc_; ++c) {
+      const Contact &k = sys_.contacts()[c];
+      diagonal[c] = diagonal_entries(sys_, c, split_of(k.a), split_of(k.b));
+    }
+    const std::vector<Vec6> split_scale = row_scales(diagonal, rows_);
+    for (int c = 0; c < nc_; ++c) inv_scale_[c] = split_scale[c].cwiseInverse();
+  } else {
+    for (std::size_t c = 0; c < scale.size(); ++c) inv_scale_[c] = scale[c].cwiseInverse();
+  }
+  inv_mass_ = split.size() ? split_inv_mass_.data() : sys_.inv_mass().data();
+}
+
+// Four contacts at a time where the processor can (sweep_groups.hpp): the full sweeps, or each
+// colour phase; not the focused sweeps' lists (kept in control.cache while the kinematics hold:
+// the same contacts, phases and masses)
+void PgsRun::prepare_groups()
+{
+  std::vector<std::unique_ptr<GroupedSweep>> &grouped = *grouped_;
+  const bool split = shares_.split.size() > 0;
+  if (control_.grouped && !focus_ && grouped_sweeps_available()) {
+    const std::size_t wanted = coloured_ ? phases_.size() : 1;
+    const bool kept = control_.cache && control_.cache->kinematics == sys_.kinematics_id() &&
+                      control_.cache->split_masses == split && grouped.size() == wanted &&
+                      sys_.row_mask().empty();
+    if (kept) {
+      for (const std::unique_ptr<GroupedSweep> &group : grouped)
+        group->refresh(sys_, cones_, b_, inv_scale_);
+    } else {
+      grouped.clear();
+      if (coloured_)
+        for (const std::vector<int> &phase : phases_)
+          grouped.push_back(std::make_unique<GroupedSweep>(sys_, cones_, b_, inv_mass_, inv_scale_,
+                                                           ex_.local_owners(), &phase));
+      else
+        grouped.push_back(std::make_unique<GroupedSweep>(sys_, cones_, b_, inv_mass_, inv_scale_,
+                                                         ex_.local_owners()));
+      if (control_.cache) {
+        control_.cache->kinematics = sys_.row_mask().empty() ? sys_.kinematics_id() : 0;
+        control_.cache->split_masses = split;
+      }
+    }
+  } else {
+    grouped.clear();
+    if (control_.cache) control_.cache->kinematics = 0;
+  }
+}
+
+void PgsRun::keep_start()
+{
+  if (!halo_bodies_) {
+    dv_start_ = dv_;
+    return;
+  }
+  for (const int body : *halo_bodies_) body_entries(dv_start_, body) = body_entries(dv_, body);
+}
+
+// Every process's updates on every body: the sum of the local changes, owners and ghosts (each
+// copy's change at the body's own mass); with colours after each colour's phase.
+void PgsRun::sweep_and_sum(const int *visit, int n, GroupedSweep *group, double *norms,
+                           double *changes)
+{
+  if (group) {
+    group->sweep(lambda_, dv_, norms);
+    visit = group->singles().data(); // then the rest one at a time
+    n = static_cast<int>(group->singles().size());
+  }
+  if (rows_ == 6)
+    fibre::sweep<6>(sys_, cones_, b_, inv_mass_, inv_scale_, ex_.local_owners(), visit, n, lambda_,
+                    dv_, norms, changes);
+  else
+    fibre::sweep<3>(sys_, cones_, b_, inv_mass_, inv_scale_, ex_.local_owners(), visit, n, lambda_,
+                    dv_, norms, changes);
+  if (!halo_) return;
+  const Vector &split = shares_.split;
+  if (!halo_bodies_) {
+    moved_ = dv_ - dv_start_;
+    if (split.size()) moved_.array() /= split.array();
+    copies_->sum_copies(moved_);
+    dv_ = dv_start_ + moved_;
+    return;
+  }
+  for (const int body : *halo_bodies_) {
+    body_entries(moved_, body) = body_entries(dv_, body) - body_entries(dv_start_, body);
+    if (split.size()) body_entries(moved_, body).array() /= body_entries(split, body).array();
+  }
+  copies_->sum_copies(moved_);
+  for (const int body : *halo_bodies_)
+    body_entries(dv_, body) = body_entries(dv_start_, body) + body_entries(moved_, body);
+}
+
+// Sweep s; true where the sweeps end (converged, stagnated or non-finite).
+bool PgsRun::sweep(int s)
+{
+  // dv follows this process's updates; `moved` collects them for the other processes.
+  if (halo_) keep_start();
+  if (control_.nonlinear_cg || s % kCheckpointSweeps == 0) lambda_start_ = lambda_;
+  if (blocks_) blocks_->correct(b_, lambda_, dv_);
+  double norms[2] = {0, 0}; // ||change||^2, ||lambda||^2
+  // focused: the first sweep is full, then every (P + 1)-th counted from min_sweeps (so the
+  // rules can stop where plain sweeps would); the P between visit the focus list
+  const int focus_period = control_.focus_sweeps + 1;
+  const bool full =
+      !focus_ || s == 0 ||
+      ((s + 1 - control_.min_sweeps) % focus_period + focus_period) % focus_period == 0;
+  const int *list = full ? nullptr : focus_contacts_.data();
+  const int count = full ? nc_ : static_cast<int>(focus_contacts_.size());
+  double *changes = full && focus_ ? contact_changes_.data() : nullptr;
+  // Anderson: plain sweeps up to the floor (steps that it ends pay nothing), the history from
+  // its last sweep on, a mix after every `period` sweeps
+  const bool mixing = accelerate_ && !plain_ && s + 1 >= control_.min_sweeps;
+  const bool mix = mixing && (s + 1 - control_.min_sweeps) % period_ == period_ - 1;
+  if (mixing && !anderson_.has_start()) anderson_.start(lambda_);
+  combination_ = false;
+  std::vector<std::unique_ptr<GroupedSweep>> &grouped = *grouped_;
+  if (coloured_) {
+    for (std::size_t p = 0; p < phases_.size(); ++p) {
+      if (p > 0) keep_start(); // the first phase starts where the sweep does
+      sweep_and_sum(phases_[p].data(), static_cast<int>(phases_[p].size()),
+                    grouped.empty() ? nullptr : grouped[p].get(), norms, changes);
+    }
+  } else {
+    sweep_and_sum(list, count, grouped.empty() ? nullptr : grouped[0].get(), norms, changes);
+  }
+  if (changes) focus_list(contact_changes_, norms[0], focus_contacts_);
+  res_.visits += count;
+  ex_.sum(norms, 2);
+  ++res_.sweeps;
+  if (!std::isfinite(norms[0]) || !std::isfinite(norms[1])) {
+    lambda_ = lambda_start_;
+    if (accelerate_) // the checkpoint may be a combination outside the cones
+      for (int c = 0; c < nc_; ++c) cones_.project(lambda_.data() + Eigen::Index(rows_) * c, c);
+    res_.reason = StopReason::non_finite;
+    return true;
+  }
+  res_.record(norms[1] > 0 ? std::sqrt(norms[0] / norms[1]) : 0.0, full);
+  // lambda is this sweep's result (feasible); a new smallest change is kept now and then
+  if (mixing && s % kCheckpointSweeps == 0 && res_.last_change < best_) {
+    lambda_best_ = lambda_;
+    have_best_ = true;
+  }
+  if (mix) {
+    res_.singular_value = anderson_.mix(lambda_, dv_); // lambda: the next start
+    res_.mixed_change = anderson_.change();
+    combination_ = anderson_.combined();
+  }
+  if (stop_rule(full, norms) || stalled()) return true;
+  if (control_.nonlinear_cg && s + 1 < control_.max_sweeps) cg_step(s, norms[0]);
+  return false;
+}
+
+// The stop rule after a sweep; true where the sweeps have converged.
+bool PgsRun::stop_rule(bool full, const double *norms)
+{
+  res_.reason = StopReason::max_iterations;
+  // with a floor, a met estimate stops the sweeps at the floor: the changes of the sweeps after
+  // it may fall to round-off, where the estimated rate means nothing
+  if (control_.accuracy > 0 && !(res_.met_estimate <= control_.accuracy) &&
+      res_.error_estimate() <= control_.accuracy)
+    res_.met_estimate = res_.error_estimate();
+  // A full sweep that moves lambda by round-off only has converged as far as doubles go: its
+  // changes may then repeat exactly (a rate of 1, an infinite estimate; a solved column under
+  // focused sweeps swept on into stagnation).
+  constexpr double kRoundOff = 64 * std::numeric_limits<double>::epsilon();
+  const bool still = full && res_.last_change <= kRoundOff; // 0 too: a sweep that changes nothing
+  if (still && control_.accuracy > 0)
+    res_.met_estimate = std::min(res_.met_estimate, res_.last_change);
+  const bool done = control_.accuracy > 0 ? res_.met_estimate <= control_.accuracy &&
+                                                (res_.sweeps >= control_.min_sweeps || still)
+                                          : !(norms[0] > control_.tol * control_.tol * norms[1]);
+  if (done && full) {
+    res_.reason = StopReason::converged;
+    return true;
+  }
+  return false;
+}
+
+// The stall rule after a sweep that did not converge; true where the sweeps end. Anderson's
+// sweeps that stall go on plain from the best checkpoint.
+bool PgsRun::stalled()
+{
+  const bool anderson_on = accelerate_ && !plain_;
+  if (res_.last_change < best_) {
+    best_ = res_.last_change;
+    since_best_ = 0;
+    return false;
+  }
+  if (++since_best_ <
+      (anderson_on ? std::min(control_.stall_sweeps, kAndersonStallSweeps) : control_.stall_sweeps))
+    return false;
+  if (!anderson_on) {
+    res_.reason = StopReason::stagnation;
+    return true;
+  }
+  plain_ = true;
+  anderson_.restart();
+  res_.restart_rate(); // the estimate follows the plain sweeps' own contraction
+  combination_ = false;
+  if (have_best_) { // a collective: every process, with or without contacts
+    lambda_ = lambda_best_;
+    dv_ = velocity_change(sys_, ex_, lambda_);
+  }
+  best_ = INFINITY;
+  since_best_ = 0;
+  return false;
+}
+
+// Nonlinear CG's step along its direction after sweep s, whose change^2 is change2.
+void PgsRun::cg_step(int s, double change2)
+{
+  change_ = lambda_ - lambda_start_;
+  const double beta = s > 0 ? change2 / last_change2_ : 2.0;
+  last_change2_ = change2;
+  if (beta > 1.0) {
+    direction_ = change_; // restart
+  } else {
+    direction_ *= beta;
+    lambda_ += direction_;
+    dv_ += velocity_change(sys_, ex_, direction_);
+    direction_ += change_;
+  }
+}
+
 } // namespace
 
 PgsResult pgs(const ContactSystem &sys, const Exchange &ex, const Cones &cones, const Vector &b,
               const std::vector<Vec6> &scale, Vector &lambda, const PgsControl &control)
 {
-  PgsResult res;
-  const int nc = sys.num_contacts(), rows = sys.rows();
-  const bool halo = ex.has_halo(); // else the round trip below is the identity
-  const std::vector<char> touched = halo ? touched_bodies(sys, ex) : std::vector<char>();
-  // the blocks' corrections are not part of the sweeps' steps, and measured with them the
-  // combination diverged on a stiff pile: plain sweeps only
-  const bool accelerate = control.anderson > 0 && !control.nonlinear_cg && !control.fibre_blocks;
-  const bool focus =
-      control.focus_sweeps > 0 && !control.nonlinear_cg && !control.fibre_blocks && !accelerate;
-  // Two process colours (Exchange::Halo::colours): the contacts on bodies that other
-  // processes' contacts move too are swept in their process's colour's phase of the sweep, so
-  // that a body that processes of two colours share moves as on one process. A body that
-  // processes of one colour share (all of them without colours) is split among them: each sees
-  // a copy of inverse mass split / m (mass splitting). Neither with fibre blocks, whose
-  // corrections move their bodies at their own mass, nor with nonlinear CG, whose steps along
-  // its direction the split slowed (12 of test_fix_solvers' 60 steps at np 2 unconverged);
-  // focused sweeps split only.
-  const bool shareable = halo && !control.fibre_blocks && !control.nonlinear_cg;
-  const bool colouring = shareable && !focus;
-  const std::unique_ptr<Exchange::Halo> copies = halo ? ex.halo(touched, colouring) : nullptr;
-  // (the counts per colour travel in a body's kBodyDofs entries)
-  const int colours = colouring && copies->colours() <= kBodyDofs ? copies->colours() : 1;
-  const int colour = colours > 1 ? copies->colour() : 0;
-  const BodyShares shares = shareable ? body_shares(touched, ex, colours, colour) : BodyShares();
-  const Vector &split = shares.split;
-  std::vector<std::vector<int>> phases;
-  if (colours > 1 && shares.total.size())
-    phases = colour_phases(sys, ex, shares.total, colours, colour);
-  const bool coloured = !phases.empty();
-  Vector split_inv_mass;
-  std::vector<Vec6> inv_scale(scale.size());
-  if (split.size()) {
-    split_inv_mass = sys.inv_mass().cwiseProduct(split);
-    const std::vector<int> &owners = ex.local_owners();
-    const auto split_of = [&](int body) {
-      if (body < 0) return 1.0;
-      return split[Eigen::Index(kBodyDofs) * owner_of(owners, body)];
-    };
-    std::vector<Vec6> diagonal(nc);
-    for (int c = 0; c < nc; ++c) {
-      const Contact &k = sys.contacts()[c];
-      diagonal[c] = diagonal_entries(sys, c, split_of(k.a), split_of(k.b));
-    }
-    const std::vector<Vec6> split_scale = row_scales(diagonal, rows);
-    for (int c = 0; c < nc; ++c) inv_scale[c] = split_scale[c].cwiseInverse();
-  } else {
-    for (std::size_t c = 0; c < scale.size(); ++c) inv_scale[c] = scale[c].cwiseInverse();
-  }
-  const double *inv_mass = split.size() ? split_inv_mass.data() : sys.inv_mass().data();
-  // the blocks read their bound rows from feasible impulses
-  if (control.fibre_blocks)
-    for (int c = 0; c < nc; ++c) cones.project(lambda.data() + Eigen::Index(rows) * c, c);
-  Vector dv = velocity_change(sys, ex, lambda);
-  // Each phase's changes go to the other processes as `moved`, from dv_start, its start: on the
-  // halo's bodies only where it names them (a few dozen, where a full vector has every ghost).
-  const std::vector<int> *halo_bodies = halo ? copies->bodies() : nullptr;
-  Vector dv_start = halo ? dv : Vector(), moved = halo ? Vector::Zero(dv.size()) : Vector();
-  const auto keep_start = [&] {
-    if (!halo_bodies) {
-      dv_start = dv;
-      return;
-    }
-    for (const int body : *halo_bodies) body_entries(dv_start, body) = body_entries(dv, body);
-  };
-  // Impulses to fall back on when a sweep turns non-finite: a copy every kCheckpointSweeps
-  // sweeps, not every sweep (stiff steps take hundreds), and every sweep for nonlinear CG,
-  // whose direction is the sweep's change.
-  constexpr int kCheckpointSweeps = 16;
-  Vector lambda_start;
-  double best = INFINITY;
-  int since_best = 0;
-  // Anderson's combination can cycle where plain sweeps converge (a LIGGGHTS heap's step: its
-  // rotations drifted off again after sweep 900). After kAndersonStallSweeps sweeps without a new
-  // smallest change the sweeps go on plain from the best checkpointed sweep.
-  bool plain = false, have_best = false; // have_best: alike on every process
-  Vector lambda_best;
-  Vector direction, change; // nonlinear CG
-  double last_change2 = 0;
-  std::unique_ptr<FibreBlocks> blocks;
-  if (control.fibre_blocks) {
-    Vector normal(nc);
-    for (int c = 0; c < nc; ++c) normal[c] = lambda[Eigen::Index(rows) * c];
-    blocks =
-        std::make_unique<FibreBlocks>(sys, ex.local_owners(), cones, control.block_weight, &normal);
-  }
-  // Four contacts at a time where the processor can (sweep_groups.hpp): the full sweeps, or
-  // each colour phase; not the focused sweeps' lists
-  // (kept in control.cache while the kinematics hold: the same contacts, phases and masses)
-  std::vector<std::unique_ptr<GroupedSweep>> own;
-  std::vector<std::unique_ptr<GroupedSweep>> &grouped =
-      control.cache ? control.cache->grouped : own;
-  if (control.grouped && !focus && grouped_sweeps_available()) {
-    const std::size_t wanted = coloured ? phases.size() : 1;
-    const bool kept = control.cache && control.cache->kinematics == sys.kinematics_id() &&
-                      control.cache->split_masses == (split.size() > 0) &&
-                      grouped.size() == wanted && sys.row_mask().empty();
-    if (kept) {
-      for (const std::unique_ptr<GroupedSweep> &group : grouped)
-        group->refresh(sys, cones, b, inv_scale);
-    } else {
-      grouped.clear();
-      if (coloured)
-        for (const std::vector<int> &phase : phases)
-          grouped.push_back(std::make_unique<GroupedSweep>(sys, cones, b, inv_mass, inv_scale,
-                                                           ex.local_owners(), &phase));
-      else
-        grouped.push_back(
-            std::make_unique<GroupedSweep>(sys, cones, b, inv_mass, inv_scale, ex.local_owners()));
-      if (control.cache) {
-        control.cache->kinematics = sys.row_mask().empty() ? sys.kinematics_id() : 0;
-        control.cache->split_masses = split.size() > 0;
-      }
-    }
-  } else {
-    grouped.clear();
-    if (control.cache) control.cache->kinematics = 0;
-  }
-  Anderson anderson(std::max(control.anderson, 1), ex);
-  const int period = std::max(control.anderson_period, 1);
-  bool combination = false; // lambda is Anderson's start, not a sweep's result
-  std::vector<double> contact_changes(focus ? nc : 0);
-  std::vector<int> focus_contacts;
-  for (int s = 0; s < control.max_sweeps; ++s) {
-    // dv follows this process's updates; `moved` collects them for the other processes.
-    if (halo) keep_start();
-    if (control.nonlinear_cg || s % kCheckpointSweeps == 0) lambda_start = lambda;
-    if (blocks) blocks->correct(b, lambda, dv);
-    double norms[2] = {0, 0}; // ||change||^2, ||lambda||^2
-    // focused: the first sweep is full, then every (P + 1)-th counted from min_sweeps (so the
-    // rules can stop where plain sweeps would); the P between visit the focus list
-    const int focus_period = control.focus_sweeps + 1;
-    const bool full =
-        !focus || s == 0 ||
-        ((s + 1 - control.min_sweeps) % focus_period + focus_period) % focus_period == 0;
-    const int *list = full ? nullptr : focus_contacts.data();
-    const int count = full ? nc : static_cast<int>(focus_contacts.size());
-    double *changes = full && focus ? contact_changes.data() : nullptr;
-    // Anderson: plain sweeps up to the floor (steps that it ends pay nothing), the history
-    // from its last sweep on, a mix after every `period` sweeps
-    const bool mixing = accelerate && !plain && s + 1 >= control.min_sweeps;
-    const bool mix = mixing && (s + 1 - control.min_sweeps) % period == period - 1;
-    if (mixing && !anderson.has_start()) anderson.start(lambda);
-    combination = false;
-    // Every process's updates on every body: the sum of the local changes, owners and ghosts
-    // (each copy's change at the body's own mass); with colours after each colour's phase.
-    const auto sweep_and_sum = [&](const int *visit, int n, GroupedSweep *group) {
-      if (group) {
-        group->sweep(lambda, dv, norms);
-        visit = group->singles().data(); // then the rest one at a time
-        n = static_cast<int>(group->singles().size());
-      }
-      if (rows == 6)
-        sweep<6>(sys, cones, b, inv_mass, inv_scale, ex.local_owners(), visit, n, lambda, dv, norms,
-                 changes);
-      else
-        sweep<3>(sys, cones, b, inv_mass, inv_scale, ex.local_owners(), visit, n, lambda, dv, norms,
-                 changes);
-      if (halo) {
-        if (!halo_bodies) {
-          moved = dv - dv_start;
-          if (split.size()) moved.array() /= split.array();
-          copies->sum_copies(moved);
-          dv = dv_start + moved;
-          return;
-        }
-        for (const int body : *halo_bodies) {
-          body_entries(moved, body) = body_entries(dv, body) - body_entries(dv_start, body);
-          if (split.size()) body_entries(moved, body).array() /= body_entries(split, body).array();
-        }
-        copies->sum_copies(moved);
-        for (const int body : *halo_bodies)
-          body_entries(dv, body) = body_entries(dv_start, body) + body_entries(moved, body);
-      }
-    };
-    if (coloured) {
-      for (std::size_t p = 0; p < phases.size(); ++p) {
-        if (p > 0) keep_start(); // the first phase starts where the sweep does
-        sweep_and_sum(phases[p].data(), static_cast<int>(phases[p].size()),
-                      grouped.empty() ? nullptr : grouped[p].get());
-      }
-    } else {
-      sweep_and_sum(list, count, grouped.empty() ? nullptr : grouped[0].get()); // no list then
-    }
-    if (changes) focus_list(contact_changes, norms[0], focus_contacts);
-    res.visits += count;
-    ex.sum(norms, 2);
-    ++res.sweeps;
-    if (!std::isfinite(norms[0]) || !std::isfinite(norms[1])) {
-      lambda = lambda_start;
-      if (accelerate) // the checkpoint may be a combination outside the cones
-        for (int c = 0; c < nc; ++c) cones.project(lambda.data() + Eigen::Index(rows) * c, c);
-      res.reason = StopReason::non_finite;
-      return res;
-    }
-    res.record(norms[1] > 0 ? std::sqrt(norms[0] / norms[1]) : 0.0, full);
-    // lambda is this sweep's result (feasible); a new smallest change is kept now and then
-    if (mixing && s % kCheckpointSweeps == 0 && res.last_change < best) {
-      lambda_best = lambda;
-      have_best = true;
-    }
-    if (mix) {
-      res.singular_value = anderson.mix(lambda, dv); // lambda: the next start
-      res.mixed_change = anderson.change();
-      combination = anderson.combined();
-    }
-    res.reason = StopReason::max_iterations;
-    // with a floor, a met estimate stops the sweeps at the floor: the changes of the sweeps
-    // after it may fall to round-off, where the estimated rate means nothing
-    if (control.accuracy > 0 && !(res.met_estimate <= control.accuracy) &&
-        res.error_estimate() <= control.accuracy)
-      res.met_estimate = res.error_estimate();
-    // A full sweep that moves lambda by round-off only has converged as far as doubles go: its
-    // changes may then repeat exactly (a rate of 1, an infinite estimate; a solved column under
-    // focused sweeps swept on into stagnation).
-    constexpr double kRoundOff = 64 * std::numeric_limits<double>::epsilon();
-    const bool still = full && res.last_change <= kRoundOff; // 0 too: a sweep that changes nothing
-    if (still && control.accuracy > 0)
-      res.met_estimate = std::min(res.met_estimate, res.last_change);
-    const bool done = control.accuracy > 0 ? res.met_estimate <= control.accuracy &&
-                                                 (res.sweeps >= control.min_sweeps || still)
-                                           : !(norms[0] > control.tol * control.tol * norms[1]);
-    if (done && full) {
-      res.reason = StopReason::converged;
-      break;
-    }
-    const bool anderson_on = accelerate && !plain;
-    if (res.last_change < best) {
-      best = res.last_change;
-      since_best = 0;
-    } else if (++since_best >= (anderson_on ? std::min(control.stall_sweeps, kAndersonStallSweeps)
-                                            : control.stall_sweeps)) {
-      if (!anderson_on) {
-        res.reason = StopReason::stagnation;
-        break;
-      }
-      plain = true;
-      anderson.restart();
-      res.restart_rate(); // the estimate follows the plain sweeps' own contraction
-      combination = false;
-      if (have_best) { // a collective: every process, with or without contacts
-        lambda = lambda_best;
-        dv = velocity_change(sys, ex, lambda);
-      }
-      best = INFINITY;
-      since_best = 0;
-    }
-    if (control.nonlinear_cg && s + 1 < control.max_sweeps) {
-      change = lambda - lambda_start;
-      const double beta = s > 0 ? norms[0] / last_change2 : 2.0;
-      last_change2 = norms[0];
-      if (beta > 1.0) {
-        direction = change; // restart
-      } else {
-        direction *= beta;
-        lambda += direction;
-        dv += velocity_change(sys, ex, direction);
-        direction += change;
-      }
-    }
-  }
-  if (combination) lambda = anderson.sweep_result();
-  if (control.nonlinear_cg) // the last step along the direction may have left the cones
-    for (int c = 0; c < nc; ++c) cones.project(lambda.data() + Eigen::Index(rows) * c, c);
-  return res;
+  return PgsRun(sys, ex, cones, b, scale, lambda, control).run();
 }
 
 } // namespace fibre
