@@ -102,144 +102,187 @@ void FibreBlocks::factor(int blk)
   valid_[blk] = 1;
 }
 
-int FibreBlocks::correct(const Vector &b, Vector &lambda, Vector &dv)
+// Block blk's mask: the rows the current impulses hold on a bound stay fixed (released
+// contacts, cones on their boundary, rows without a cone). Returns whether a row is free; a
+// changed mask needs a new factorization.
+bool FibreBlocks::update_mask(int blk, const Vector &lambda)
 {
   const int R = rows_;
-  const double *inv_mass = sys_.inv_mass().data(), *sigma = sys_.sigma().data();
-  std::vector<Vec6> &rho = rho_, &x = x_, &step = step_, &trial = trial_;
-  int kept = 0;
-  for (int blk = 0; blk < num_blocks(); ++blk) {
-    const int k0 = start_[blk], k1 = start_[blk + 1];
-    // The rows the current impulses hold on a bound stay fixed: released contacts, cones on
-    // their boundary (their magnitude follows lambda_n in the sweep), rows without a cone.
-    bool changed = false, any_free = false;
-    for (int k = k0; k < k1; ++k) {
-      const int c = contacts_[k];
-      const double *l = lambda.data() + Eigen::Index(R) * c;
-      unsigned char m[6] = {0, 0, 0, 0, 0, 0};
-      if (l[0] > 0) {
-        m[0] = 1;
-        for (int j = 0; j < num_cones(R); ++j) {
-          const Cone &cone = kCones[j];
-          const double radius = cones_.coeff(c, j) * l[0];
-          double t2 = l[cone.first] * l[cone.first];
-          if (cone.size == 2) t2 += l[cone.first + 1] * l[cone.first + 1];
-          const bool free = radius > 0 && std::sqrt(t2) < radius * (1 - 1e-9);
-          for (int i = 0; i < cone.size; ++i) m[cone.first + i] = free;
-        }
-      }
-      for (int i = 0; i < 6; ++i) {
-        changed |= mask_[6 * std::size_t(k) + i] != m[i];
-        mask_[6 * std::size_t(k) + i] = m[i];
-        any_free |= m[i] != 0;
-      }
-    }
-    if (changed) valid_[blk] = 0;
-    if (!any_free) continue;
-    if (valid_[blk] == 0) factor(blk);
-    if (valid_[blk] != 1) continue;
-
-    // rho = b - G dv - Sigma lambda on the block's rows (the full residual: it enters the
-    // energy on every row), then the masked solve A_BB x = rho (forward, then back).
-    for (int k = k0; k < k1; ++k) {
-      const int c = contacts_[k];
-      const ContactKinematics &q = sys_.kinematics(c);
-      const Contact &contact = sys_.contacts()[c];
-      const int a = body_of(contact.a), bb = body_of(contact.b);
-      double u[6] = {0, 0, 0, 0, 0, 0};
-      contact_velocity<6>(q.frame.data(), q.ra.data(), q.rb.data(), dv.data() + 6 * Eigen::Index(a),
-                          bb >= 0 ? dv.data() + 6 * Eigen::Index(bb) : nullptr, u);
-      rho[k].setZero();
-      for (int i = 0; i < R; ++i) {
-        const Eigen::Index row = Eigen::Index(R) * c + i;
-        rho[k][i] = b[row] - u[i] - sigma[row] * lambda[row];
-      }
-      Vec6 y = rho[k];
-      if (k > k0) y -= lower_[k] * x[k - 1]; // x holds y of the previous contact here
-      for (int i = 0; i < 6; ++i)
-        if (!mask_[6 * std::size_t(k) + i]) y[i] = 0.0;
-      x[k] = y;
-    }
-    for (int k = k1 - 1; k >= k0; --k) {
-      Vec6 y = x[k];
-      if (k + 1 < k1) y -= upper_[k] * x[k + 1];
-      for (int i = 0; i < 6; ++i)
-        if (!mask_[6 * std::size_t(k) + i]) y[i] = 0.0;
-      x[k] = inv_pivot_[k] * y;
-    }
-
-    // Two candidate steps, each projected: the full solve, and the solve cut back to where it
-    // first leaves the free rows' bounds (a descent direction of the masked quadratic, so the
-    // cut step lowers the energy unless the sliding cones' rescaling undoes it). The lower of
-    // the two energies -rho . step + step . A_BB step / 2 is kept when it is negative.
-    double alpha = 1.0;
-    for (int k = k0; k < k1; ++k) {
-      const int c = contacts_[k];
-      const double *l = lambda.data() + Eigen::Index(R) * c;
-      const unsigned char *m = &mask_[6 * std::size_t(k)];
-      if (!m[0]) continue;
-      if (x[k][0] < 0) alpha = std::min(alpha, -l[0] / x[k][0]);
+  const int k0 = start_[blk], k1 = start_[blk + 1];
+  // The rows the current impulses hold on a bound stay fixed: released contacts, cones on
+  // their boundary (their magnitude follows lambda_n in the sweep), rows without a cone.
+  bool changed = false, any_free = false;
+  for (int k = k0; k < k1; ++k) {
+    const int c = contacts_[k];
+    const double *l = lambda.data() + Eigen::Index(R) * c;
+    unsigned char m[6] = {0, 0, 0, 0, 0, 0};
+    if (l[0] > 0) {
+      m[0] = 1;
       for (int j = 0; j < num_cones(R); ++j) {
         const Cone &cone = kCones[j];
-        if (!m[cone.first]) continue;
-        const double mu = cones_.coeff(c, j);
-        Eigen::Vector2d t(l[cone.first], cone.size == 2 ? l[cone.first + 1] : 0.0);
-        Eigen::Vector2d d(x[k][cone.first], cone.size == 2 ? x[k][cone.first + 1] : 0.0);
-        // |t + a d|^2 - mu^2 (l_n + a x_n)^2 = qa a^2 + qb a + qc, qc < 0 inside the cone
-        const double qa = d.squaredNorm() - mu * mu * x[k][0] * x[k][0];
-        const double qb = 2 * (t.dot(d) - mu * mu * l[0] * x[k][0]);
-        const double qc = t.squaredNorm() - mu * mu * l[0] * l[0];
-        const double disc = qb * qb - 4 * qa * qc;
-        if (qa == 0) {
-          if (qb > 0) alpha = std::min(alpha, -qc / qb);
-        } else if (disc >= 0) {
-          const double r1 = (-qb + std::sqrt(disc)) / (2 * qa);
-          const double r2 = (-qb - std::sqrt(disc)) / (2 * qa);
-          const double r = r1 > 0 && (r2 <= 0 || r1 < r2) ? r1 : r2;
-          if (r > 0) alpha = std::min(alpha, r);
-        }
+        const double radius = cones_.coeff(c, j) * l[0];
+        double t2 = l[cone.first] * l[cone.first];
+        if (cone.size == 2) t2 += l[cone.first + 1] * l[cone.first + 1];
+        const bool free = radius > 0 && std::sqrt(t2) < radius * (1 - 1e-9);
+        for (int i = 0; i < cone.size; ++i) m[cone.first + i] = free;
       }
     }
-    double energy = INFINITY;
-    for (double a : {1.0, alpha}) {
-      if (!(a > 0)) continue;
-      double e = 0;
-      for (int k = k0; k < k1; ++k) {
-        const int c = contacts_[k];
-        double l[6] = {0, 0, 0, 0, 0, 0};
-        for (int i = 0; i < R; ++i) l[i] = lambda[Eigen::Index(R) * c + i] + a * x[k][i];
-        cones_.project(l, c);
-        trial[k].setZero();
-        for (int i = 0; i < R; ++i) trial[k][i] = l[i] - lambda[Eigen::Index(R) * c + i];
-        e -= rho[k].dot(trial[k]);
-      }
-      for (int k = k0; k < k1; ++k) {
-        Vec6 a_step = diag_[k] * trial[k];
-        if (k + 1 < k1) a_step += upper_[k] * trial[k + 1];
-        if (k > k0) a_step += upper_[k - 1].transpose() * trial[k - 1];
-        e += 0.5 * trial[k].dot(a_step);
-      }
-      if (e < energy) {
-        energy = e;
-        for (int k = k0; k < k1; ++k) step[k] = trial[k];
-      }
-      if (alpha >= 1.0) break;
+    for (int i = 0; i < 6; ++i) {
+      changed |= mask_[6 * std::size_t(k) + i] != m[i];
+      mask_[6 * std::size_t(k) + i] = m[i];
+      any_free |= m[i] != 0;
     }
-    if (!(energy < 0)) continue;
-    ++kept;
+  }
+  if (changed) valid_[blk] = 0;
+  return any_free;
+}
+
+// rho and the masked solve x of block blk.
+void FibreBlocks::solve_block(int blk, const Vector &b, const Vector &lambda, const Vector &dv)
+{
+  const int R = rows_;
+  const double *sigma = sys_.sigma().data();
+  std::vector<Vec6> &rho = rho_, &x = x_;
+  const int k0 = start_[blk], k1 = start_[blk + 1];
+  // rho = b - G dv - Sigma lambda on the block's rows (the full residual: it enters the
+  // energy on every row), then the masked solve A_BB x = rho (forward, then back).
+  for (int k = k0; k < k1; ++k) {
+    const int c = contacts_[k];
+    const ContactKinematics &q = sys_.kinematics(c);
+    const Contact &contact = sys_.contacts()[c];
+    const int a = body_of(contact.a), bb = body_of(contact.b);
+    double u[6] = {0, 0, 0, 0, 0, 0};
+    contact_velocity<6>(q.frame.data(), q.ra.data(), q.rb.data(), dv.data() + 6 * Eigen::Index(a),
+                        bb >= 0 ? dv.data() + 6 * Eigen::Index(bb) : nullptr, u);
+    rho[k].setZero();
+    for (int i = 0; i < R; ++i) {
+      const Eigen::Index row = Eigen::Index(R) * c + i;
+      rho[k][i] = b[row] - u[i] - sigma[row] * lambda[row];
+    }
+    Vec6 y = rho[k];
+    if (k > k0) y -= lower_[k] * x[k - 1]; // x holds y of the previous contact here
+    for (int i = 0; i < 6; ++i)
+      if (!mask_[6 * std::size_t(k) + i]) y[i] = 0.0;
+    x[k] = y;
+  }
+  for (int k = k1 - 1; k >= k0; --k) {
+    Vec6 y = x[k];
+    if (k + 1 < k1) y -= upper_[k] * x[k + 1];
+    for (int i = 0; i < 6; ++i)
+      if (!mask_[6 * std::size_t(k) + i]) y[i] = 0.0;
+    x[k] = inv_pivot_[k] * y;
+  }
+}
+
+// Two candidate steps, each projected: the full solve, and the solve cut back to where it
+// first leaves the free rows' bounds (a descent direction of the masked quadratic, so the
+// cut step lowers the energy unless the sliding cones' rescaling undoes it). The lower of
+// the two energies -rho . step + step . A_BB step / 2 is kept when it is negative.
+// The step along x at which block blk first leaves the free rows' bounds (at most 1).
+double FibreBlocks::step_limit(int blk, const Vector &lambda) const
+{
+  const int R = rows_;
+  const std::vector<Vec6> &x = x_;
+  const int k0 = start_[blk], k1 = start_[blk + 1];
+  double alpha = 1.0;
+  for (int k = k0; k < k1; ++k) {
+    const int c = contacts_[k];
+    const double *l = lambda.data() + Eigen::Index(R) * c;
+    const unsigned char *m = &mask_[6 * std::size_t(k)];
+    if (!m[0]) continue;
+    if (x[k][0] < 0) alpha = std::min(alpha, -l[0] / x[k][0]);
+    for (int j = 0; j < num_cones(R); ++j) {
+      const Cone &cone = kCones[j];
+      if (!m[cone.first]) continue;
+      const double mu = cones_.coeff(c, j);
+      Eigen::Vector2d t(l[cone.first], cone.size == 2 ? l[cone.first + 1] : 0.0);
+      Eigen::Vector2d d(x[k][cone.first], cone.size == 2 ? x[k][cone.first + 1] : 0.0);
+      // |t + a d|^2 - mu^2 (l_n + a x_n)^2 = qa a^2 + qb a + qc, qc < 0 inside the cone
+      const double qa = d.squaredNorm() - mu * mu * x[k][0] * x[k][0];
+      const double qb = 2 * (t.dot(d) - mu * mu * l[0] * x[k][0]);
+      const double qc = t.squaredNorm() - mu * mu * l[0] * l[0];
+      const double disc = qb * qb - 4 * qa * qc;
+      if (qa == 0) {
+        if (qb > 0) alpha = std::min(alpha, -qc / qb);
+      } else if (disc >= 0) {
+        const double r1 = (-qb + std::sqrt(disc)) / (2 * qa);
+        const double r2 = (-qb - std::sqrt(disc)) / (2 * qa);
+        const double r = r1 > 0 && (r2 <= 0 || r1 < r2) ? r1 : r2;
+        if (r > 0) alpha = std::min(alpha, r);
+      }
+    }
+  }
+  return alpha;
+}
+
+// The lower energy of the two projected candidates (the full step and the cut one), its step
+// in step_.
+double FibreBlocks::best_step(int blk, const Vector &lambda, double alpha)
+{
+  const int R = rows_;
+  std::vector<Vec6> &rho = rho_, &x = x_, &step = step_, &trial = trial_;
+  const int k0 = start_[blk], k1 = start_[blk + 1];
+  double energy = INFINITY;
+  for (double a : {1.0, alpha}) {
+    if (!(a > 0)) continue;
+    double e = 0;
     for (int k = k0; k < k1; ++k) {
       const int c = contacts_[k];
-      const ContactKinematics &q = sys_.kinematics(c);
-      const Contact &contact = sys_.contacts()[c];
-      const int a = body_of(contact.a), bb = body_of(contact.b);
-      for (int i = 0; i < R; ++i) lambda[Eigen::Index(R) * c + i] += step[k][i];
-      double ya[6] = {0, 0, 0, 0, 0, 0}, yb[6] = {0, 0, 0, 0, 0, 0};
-      contact_impulse<6>(q.frame.data(), q.ra.data(), q.rb.data(), step[k].data(), ya,
-                         bb >= 0 ? yb : nullptr);
-      for (int d = 0; d < 6; ++d) dv[6 * Eigen::Index(a) + d] += inv_mass[6 * a + d] * ya[d];
-      if (bb >= 0)
-        for (int d = 0; d < 6; ++d) dv[6 * Eigen::Index(bb) + d] += inv_mass[6 * bb + d] * yb[d];
+      double l[6] = {0, 0, 0, 0, 0, 0};
+      for (int i = 0; i < R; ++i) l[i] = lambda[Eigen::Index(R) * c + i] + a * x[k][i];
+      cones_.project(l, c);
+      trial[k].setZero();
+      for (int i = 0; i < R; ++i) trial[k][i] = l[i] - lambda[Eigen::Index(R) * c + i];
+      e -= rho[k].dot(trial[k]);
     }
+    for (int k = k0; k < k1; ++k) {
+      Vec6 a_step = diag_[k] * trial[k];
+      if (k + 1 < k1) a_step += upper_[k] * trial[k + 1];
+      if (k > k0) a_step += upper_[k - 1].transpose() * trial[k - 1];
+      e += 0.5 * trial[k].dot(a_step);
+    }
+    if (e < energy) {
+      energy = e;
+      for (int k = k0; k < k1; ++k) step[k] = trial[k];
+    }
+    if (alpha >= 1.0) break;
+  }
+  return energy;
+}
+
+// lambda and dv take block blk's step.
+void FibreBlocks::apply_step(int blk, Vector &lambda, Vector &dv) const
+{
+  const int R = rows_;
+  const double *inv_mass = sys_.inv_mass().data();
+  const std::vector<Vec6> &step = step_;
+  const int k0 = start_[blk], k1 = start_[blk + 1];
+  for (int k = k0; k < k1; ++k) {
+    const int c = contacts_[k];
+    const ContactKinematics &q = sys_.kinematics(c);
+    const Contact &contact = sys_.contacts()[c];
+    const int a = body_of(contact.a), bb = body_of(contact.b);
+    for (int i = 0; i < R; ++i) lambda[Eigen::Index(R) * c + i] += step[k][i];
+    double ya[6] = {0, 0, 0, 0, 0, 0}, yb[6] = {0, 0, 0, 0, 0, 0};
+    contact_impulse<6>(q.frame.data(), q.ra.data(), q.rb.data(), step[k].data(), ya,
+                       bb >= 0 ? yb : nullptr);
+    for (int d = 0; d < 6; ++d) dv[6 * Eigen::Index(a) + d] += inv_mass[6 * a + d] * ya[d];
+    if (bb >= 0)
+      for (int d = 0; d < 6; ++d) dv[6 * Eigen::Index(bb) + d] += inv_mass[6 * bb + d] * yb[d];
+  }
+}
+
+int FibreBlocks::correct(const Vector &b, Vector &lambda, Vector &dv)
+{
+  int kept = 0;
+  for (int blk = 0; blk < num_blocks(); ++blk) {
+    if (!update_mask(blk, lambda)) continue;
+    if (valid_[blk] == 0) factor(blk);
+    if (valid_[blk] != 1) continue;
+    solve_block(blk, b, lambda, dv);
+    if (!(best_step(blk, lambda, step_limit(blk, lambda)) < 0)) continue;
+    ++kept;
+    apply_step(blk, lambda, dv);
   }
   return kept;
 }

@@ -34,6 +34,11 @@ class FibreBlocks {
  private:
   using Mat = Mat6; // rows beyond sys.rows() are padded as decoupled identity rows
   void factor(int blk);
+  bool update_mask(int blk, const Vector &lambda);
+  void solve_block(int blk, const Vector &b, const Vector &lambda, const Vector &dv);
+  double step_limit(int blk, const Vector &lambda) const;
+  double best_step(int blk, const Vector &lambda, double alpha);
+  void apply_step(int blk, Vector &lambda, Vector &dv) const;
   int body_of(int index) const { return owners_.empty() || index < 0 ? index : owners_[index]; }
 
   const ContactSystem &sys_;
