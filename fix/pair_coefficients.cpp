@@ -60,6 +60,51 @@ const char *const kDamping[] = {"velocity", "mass_velocity", "viscoelastic", "ts
 constexpr int kTsuji = 3, kDmt = 3, kJkr = 4;
 constexpr int kTangentialModels = 6;
 
+// One type pair of pair style granular's record: its model indices (normal, damping,
+// tangential, rolling, twisting, limit_damping) and the coefficients of each sub-model.
+void set_granular(const int *model, const double *normal, const double *tangential,
+                  const double *roll, const double *twist, fibre::PairCoefficients &p)
+{
+  p.set = true;
+  p.mu = tangential[2];
+  p.mu_roll = model[3] == 1 ? roll[2] : 0.0;
+  p.twist = model[4] == 1   ? fibre::TwistLaw::sds
+            : model[4] == 2 ? fibre::TwistLaw::marshall
+                            : fibre::TwistLaw::none;
+  p.twist_coeff = model[4] == 1 ? twist[2] : 0.0;
+  p.limit_damping = model[5] != 0;
+  // elastic laws (compliance material); dmt's and jkr's elastic part is hertz/material's
+  // (LAMMPS stores 4/3 E_eff for all three)
+  const fibre::NormalLaw laws[5] = {
+      fibre::NormalLaw::hooke, fibre::NormalLaw::hertz, fibre::NormalLaw::hertz_material,
+      fibre::NormalLaw::hertz_material, fibre::NormalLaw::hertz_material};
+  p.normal = laws[model[0]];
+  p.k_n = normal[0];
+  p.tangential = model[2] == 0   ? fibre::TangentialLaw::none
+                 : model[2] == 1 ? fibre::TangentialLaw::linear
+                                 : fibre::TangentialLaw::mindlin;
+  p.k_t = tangential[0];
+  p.k_roll = model[3] == 1 ? roll[0] : 0.0;
+  p.k_twist = model[4] == 1 ? twist[0] : 0.0;
+  p.gamma_roll = model[3] == 1 ? roll[1] : 0.0;
+  p.gamma_twist = model[4] == 1 ? twist[1] : 0.0;
+  // the rebound LAMMPS's own law gives (dmt and jkr: their Hertz part)
+  if (model[1] == kTsuji) {
+    p.damping_alpha = normal[1];
+    p.restitution = fibre::rebound_restitution(model[0] == 0 ? fibre::NormalLaw::hooke
+                                                             : fibre::NormalLaw::hertz,
+                                               normal[1], p.limit_damping);
+  }
+  // the viscous models' dashpots (velocity, mass_velocity, viscoelastic: 0, 1, 2)
+  if (model[1] != kTsuji) {
+    const fibre::ViscousDamping viscous[3] = {fibre::ViscousDamping::velocity,
+                                              fibre::ViscousDamping::mass_velocity,
+                                              fibre::ViscousDamping::viscoelastic};
+    p.viscous = viscous[model[1]];
+    p.viscous_coeff = normal[1];
+  }
+}
+
 void read_granular(const std::string &bytes, int ntypes, PairReading &out)
 {
   Record rec(bytes);
@@ -82,45 +127,7 @@ void read_granular(const std::string &bytes, int ntypes, PairReading &out)
         out.failure = "unexpected record of pair style granular (LAMMPS version layout)";
         return;
       }
-      fibre::PairCoefficients &p = table.at(i, j);
-      p.set = true;
-      p.mu = tangential[2];
-      p.mu_roll = model[3] == 1 ? roll[2] : 0.0;
-      p.twist = model[4] == 1   ? fibre::TwistLaw::sds
-                : model[4] == 2 ? fibre::TwistLaw::marshall
-                                : fibre::TwistLaw::none;
-      p.twist_coeff = model[4] == 1 ? twist[2] : 0.0;
-      p.limit_damping = model[5] != 0;
-      // elastic laws (compliance material); dmt's and jkr's elastic part is hertz/material's
-      // (LAMMPS stores 4/3 E_eff for all three)
-      const fibre::NormalLaw laws[5] = {
-          fibre::NormalLaw::hooke, fibre::NormalLaw::hertz, fibre::NormalLaw::hertz_material,
-          fibre::NormalLaw::hertz_material, fibre::NormalLaw::hertz_material};
-      p.normal = laws[model[0]];
-      p.k_n = normal[0];
-      p.tangential = model[2] == 0   ? fibre::TangentialLaw::none
-                     : model[2] == 1 ? fibre::TangentialLaw::linear
-                                     : fibre::TangentialLaw::mindlin;
-      p.k_t = tangential[0];
-      p.k_roll = model[3] == 1 ? roll[0] : 0.0;
-      p.k_twist = model[4] == 1 ? twist[0] : 0.0;
-      p.gamma_roll = model[3] == 1 ? roll[1] : 0.0;
-      p.gamma_twist = model[4] == 1 ? twist[1] : 0.0;
-      // the rebound LAMMPS's own law gives (dmt and jkr: their Hertz part)
-      if (model[1] == kTsuji) {
-        p.damping_alpha = normal[1];
-        p.restitution = fibre::rebound_restitution(model[0] == 0 ? fibre::NormalLaw::hooke
-                                                                 : fibre::NormalLaw::hertz,
-                                                   normal[1], p.limit_damping);
-      }
-      // the viscous models' dashpots (velocity, mass_velocity, viscoelastic: 0, 1, 2)
-      if (model[1] != kTsuji) {
-        const fibre::ViscousDamping viscous[3] = {fibre::ViscousDamping::velocity,
-                                                  fibre::ViscousDamping::mass_velocity,
-                                                  fibre::ViscousDamping::viscoelastic};
-        p.viscous = viscous[model[1]];
-        p.viscous_coeff = normal[1];
-      }
+      set_granular(model, normal, tangential, roll, twist, table.at(i, j));
       if (model[0] == kDmt || model[0] == kJkr)
         cohesion += (cohesion.empty() ? "" : ", ") + std::to_string(i) + " " + std::to_string(j) +
                     (model[0] == kDmt ? " dmt" : " jkr");
