@@ -7,8 +7,8 @@
 #   nncg       solver nncg (the sweeps with nonsmooth nonlinear CG), S sweeps
 #   fbgs       solver fbgs (the sweeps with fibre-block corrections), S sweeps
 #   apgd       solver apgd (accelerated projected gradient), S iterations
-#   cg         the linear pass (body form, tree-preconditioned CG) then S sweeps (the default
-#              until session 11)
+#   cg         the linear pass (body form, tree-preconditioned CG) then S sweeps (the
+#              default before the sweeps alone)
 #   cg+nncg    the same with the sweeps accelerated (sweep_cg yes)
 #   pgs-tol    solver pgs stopped at its accuracy estimate A (tol A; the default is tol 1e-4)
 #   cg-tol     solver cg stopped the same way

@@ -11,9 +11,8 @@ in.janssen.native with seeds 4767, 1031 and 2203: 2,560 spheres filled in 4 batc
 - against the native twin: Janssen's saturation pressure p_sat (the fit of
   p_sat (1 - exp(-(h - z) / lambda)) to the side-wall pressure by height, examples/janssen/
   janssen.py), the deep pressure and the floor's share, each the mean of the three seeds,
-  within 10%. Measured (examples/README.md): the means agreed to 2.8%, 1.0% and 4.2%
-  (session 13) and to 6.9%, 1.6% and 3.3% (session 21, a build that differs only in
-  round-off). One seed's p_sat scatters by about 9% (standard deviation; fibre 32.8 to 41.9
+  within 10%. Measured (examples/README.md): the means agreed to 2.8%, 1.0% and 4.2%,
+  and to 6.9%, 1.6% and 3.3% with a build that differs only in round-off. One seed's p_sat scatters by about 9% (standard deviation; fibre 32.8 to 41.9
   over nine runs), so two seeds' mean moved from 1.075 to 1.118 of native's with round-off
   alone: three seeds, the target's own measurement, are compared.
 - on two processes (seed 4767, the fix only), against the serial run of the same seed: the
@@ -21,8 +20,8 @@ in.janssen.native with seeds 4767, 1031 and 2203: 2,560 spheres filled in 4 batc
   carries less than 80% of it, the deep pressure is within 10% and p_sat within 30% (the
   trajectories part at round-off, and the fitted p_sat scatters by about 9% a run: a check
   against gross errors). Seed 4767's p_sat sits high (46.0 serial, 1.28 of native's mean), so
-  the serial run of the same seed is the reference, not native's mean. Measured (session 40):
-  np 2 against serial, deep 32.00 against 31.96, p_sat 47.9 against 46.0.
+  the serial run of the same seed is the reference, not native's mean. Measured: np 2 against
+  serial, deep 32.00 against 31.96, p_sat 47.9 against 46.0.
 """
 
 import argparse

@@ -14,8 +14,8 @@ Mixer (blade period 4 s, 1 s at rest, a quarter turn), serial and on two process
 beds each (seeds 11 to 18, the default tol 1e-4): no sphere lost, the energy balance within 2%
 of the blade's work, and serial and np 2 agree on the mean work within 10%. The ploughed bed is
 chaotic: a 1% change of the stopping rule moves one run's work by up to 14%, so single runs are
-no comparison. Until session 36 the ensemble was one bed under four values of tol (0.98 to 1.01
-times 1e-4); with Anderson mixing after every second sweep the steps stop on fewer distinct
+no comparison. An ensemble of one bed under four values of tol (0.98 to 1.01
+times 1e-4) does not do: with Anderson mixing after every second sweep the steps stop on fewer distinct
 sweeps, several of those runs were one, and twelve such runs parted by 13% (serial 13,261,
 np 2 15,164) where eight beds part by 5.1% (12,781 and 13,436, standard errors 375 and 442;
 mixing after every sweep 13,374 and 12,652).

@@ -33,7 +33,7 @@ StepOptions sweeps_only(Method m, int sweeps)
   return o;
 }
 
-// The defaults before session 11, with which the shipped state was exported: the tree-CG pass
+// The former defaults, with which the shipped state was exported: the tree-CG pass
 // and at most 50 sweeps, no step accuracy, every sweep full, one contact at a time.
 StepOptions former_default()
 {
@@ -266,7 +266,7 @@ TEST(AccuracyStudy, AndersonFallsBackToPlainSweepsWhereItsCombinationCycles)
 
 // A stiff pile's step (material deck, N 350, E = 1e8, seed 12, step 1158) whose sweeps go a
 // thousand sweeps without a new smallest change while a wedged sphere works its way out, and
-// then converge. The run that exported it (the stagnation rule of before session 39) stopped
+// then converge. The run that exported it (under a former stagnation rule) stopped
 // after 1,385 sweeps with the rotations 16% off; under the accuracy rule only the cap ends the
 // sweeps now.
 TEST(AccuracyStudy, StiffPileStepConvergesPastAThousandSweepsWithoutANewSmallestChange)

@@ -260,7 +260,7 @@ TEST(Spectra, LanczosMatchesDenseOnPilesBothForms)
 
 TEST(Spectra, LanczosMatchesDenseForTheLibraryPreconditioners)
 {
-  // fibre and tree come from make_preconditioner (preconditioners.cpp).
+  // fibre and tree come from make_preconditioner (preconditioner_family.cpp).
   const ContactSystem sys = pile_scene(kPile, design_sigma_params());
   for (Form form : {Form::contact, Form::body})
     for (PrecondKind kind : {PrecondKind::block, PrecondKind::fibre, PrecondKind::tree}) {

@@ -329,7 +329,7 @@ TEST(ContactSolver, RollingSpringAtTheConeKeepsTheConeLessItsDamper)
 // (1.2 times the cone's displacement), slowly enough that the damper (tau = 10 ms) holds the
 // sum inside the cone: the spring is not at its limit and unloads by h G v+. Rescaled on the
 // spring alone it went back to the cone every step and kept pushing: a sphere on an obstacle
-// then rolled back uphill (doc/design.md, session 18).
+// then rolled back uphill.
 TEST(ContactSolver, RollingSpringPushingAlongTheMotionUnloads)
 {
   const double m = 1.5, r = 0.4, mu_roll = 0.1, tau = 10e-3;
@@ -406,10 +406,10 @@ TEST(ContactSolver, RollingSphereSlowsAtTheConesRate)
 // A loaded Hertz contact resolved by the step (omega h = 0.07) is the pair style's damped law:
 // a sphere resting on the floor, pushed down at 0.05 m/s, swings to the overlaps that LAMMPS's
 // law F = k_n a d + alpha sqrt(m k_n a) d' (damping tsuji, e = 0.5; a = sqrt(r d)) gives,
-// integrated by RK4, within 8%. Critical damping in its place (the rule before session 17)
+// integrated by RK4, within 8%. Critical damping in its place (a former rule)
 // leaves 40% of the swing and 1% of the rebound. What is left (6% short) is the secant at the
 // last step's force, which holds the dashpot's force too: at the overlap alone it was within
-// 0.3%, but a sphere at rest on an obstacle then crept (doc/design.md, session 17).
+// 0.3%, but a sphere at rest on an obstacle then crept.
 TEST(ContactSolver, LoadedHertzContactSwingsAsTheDampedLaw)
 {
   const double m = 0.2, r = 0.25, v0 = 0.05, t_end = 0.12;

@@ -179,7 +179,7 @@ std::vector<std::array<double, kMaxRows>> advance_springs(const ContactSystem &s
       // cone's radius per unit time. A spring that pushes along the motion while its damper
       // holds the sum inside the cone is not at its limit: it unloads as the contact moves.
       // (Tested on the spring alone, that spring was put back at the cone every step and drove
-      // a sphere back up an obstacle; doc/design.md, session 18.)
+      // a sphere back up an obstacle.)
       const double eps = k.compliance[rows_of.first];
       const double coeff = cone_coefficient(k.friction, sys.effective_radius(c), cone);
       const double limit = eps * coeff * lambda_n / h;

@@ -45,7 +45,7 @@ namespace {
 // large step and a stiff material a fraction phi = t_c / h of the step: its springs and
 // dampers act for t_c (stiffness phi^2 k and damping phi gamma give the collision's impulses
 // k t_c^2 and gamma t_c). Over the whole step they took 1 / phi times the rolling resistance of
-// every bounce (doc/design.md, session 16). d is the rows' damping (steps) so far.
+// every bounce. d is the rows' damping (steps) so far.
 void shorten_to_collision(const PairCoefficients &pc, const SpookParams &params, double reff,
                           double m_eff, double approach, double d, int rows, Contact &c)
 {
@@ -116,7 +116,7 @@ void apply_pair(const ContactModel &model, const PairCoefficients &pc, const Spo
   // time gamma_n / k), at least SPOOK's d, below which a contact stiffer than the step rings
   // (normal_relaxation spook, the default; law: see the end of this function). A
   // law without a dashpot is damped critically, tau = 2 sqrt(m_eff eps). Its springs keep at
-  // least that critical damping (below). Bounces come from e (doc/design.md, session 17).
+  // least that critical damping (below). Bounces come from e.
   const double m_eff = effective_mass(bodies, c);
   double critical = 0.0;   // the normal row's, in steps
   double tau_n = INFINITY; // the normal row's damping time (seconds): the law's dashpot
@@ -128,10 +128,10 @@ void apply_pair(const ContactModel &model, const PairCoefficients &pc, const Spo
     if (tau_n / h > model.damping) c.damping = tau_n / h;
   }
   // The springs take at least the contact's damping and the normal row's critical damping:
-  // below it a pile at rest rocks on its rolling springs (session 15), and a sphere that a
-  // bowl's rolling resistance stops rolls back up (session 17). The SDS rolling and twisting
+  // below it a pile at rest rocks on its rolling springs, and a sphere that a bowl's
+  // rolling resistance stops rolls back up. The SDS rolling and twisting
   // springs carry the law's own damper (SPOOK's damping time is the Kelvin-Voigt element's
-  // gamma / k) where that is longer (doc/design.md, session 15).
+  // gamma / k) where that is longer.
   const double contact_d = std::max(model.damping, c.damping);
   const double floor = std::max(contact_d, critical);
   for (int r = 1; r <= 2 && r < rows; ++r)
@@ -188,7 +188,7 @@ void apply_contact_model(const ContactModel &model, const SpookParams &params, d
     // contact's trial impulse is zero, and such a load made the contact an enduring one,
     // without restitution and with the compliance of a vanishing load (0.1 where the rigid
     // row's is 1e-8), so that one impact bounced by Newton's law in the run and by the law's
-    // spring in the converged step (session 42).
+    // spring in the converged step.
     const Eigen::Index normal = Eigen::Index(model.rows) * Eigen::Index(k);
     double last_normal = last && last->size() > normal ? std::max((*last)[normal], 0.0) : 0.0;
     const double speed = std::abs(normal_approach(bodies, c)) + params.bounce_speed;

@@ -13,10 +13,10 @@ enum class Next { iterate, restart, stop };
 
 // Everything the three methods share: norms of b, the stop test with its true-residual
 // check, history and the non-finite guard. The methods keep only their recurrences.
-class Session {
+class KrylovState {
  public:
-  Session(const LinearOperator &A, const Preconditioner &P, const Vector &b, Vector &x,
-          const StopControl &stop, const KrylovMonitor *monitor)
+  KrylovState(const LinearOperator &A, const Preconditioner &P, const Vector &b, Vector &x,
+              const StopControl &stop, const KrylovMonitor *monitor)
       : A_(A), b_(b), stop_(stop), monitor_(monitor), x0_(x)
   {
     if (b.size() != A.size()) throw std::invalid_argument("krylov: rhs size differs from A");
@@ -174,7 +174,7 @@ class Session {
 SolveResult cg(const LinearOperator &A, const Preconditioner &P, const Vector &b, Vector &x,
                const StopControl &stop, const KrylovMonitor *monitor)
 {
-  Session s(A, P, b, x, stop, monitor);
+  KrylovState s(A, P, b, x, stop, monitor);
   Vector r, z, p, Ap;
   double rz = 0;
   int k = 0;
@@ -213,7 +213,7 @@ SolveResult cg(const LinearOperator &A, const Preconditioner &P, const Vector &b
 SolveResult conjugate_residual(const LinearOperator &A, const Preconditioner &P, const Vector &b,
                                Vector &x, const StopControl &stop, const KrylovMonitor *monitor)
 {
-  Session s(A, P, b, x, stop, monitor);
+  KrylovState s(A, P, b, x, stop, monitor);
   Vector r, z, p, Az, Ap, q;
   double zAz = 0;
   int k = 0;
@@ -261,7 +261,7 @@ SolveResult conjugate_residual(const LinearOperator &A, const Preconditioner &P,
 SolveResult minres(const LinearOperator &A, const Preconditioner &P, const Vector &b, Vector &x,
                    const StopControl &stop, const KrylovMonitor *monitor)
 {
-  Session s(A, P, b, x, stop, monitor);
+  KrylovState s(A, P, b, x, stop, monitor);
   const Eigen::Index n = A.size();
   Vector r, r1, r2, y, v, Av, w, w1, w2, Aw, Aw1, Aw2;
   double beta = 0, oldb = 0, dbar = 0, epsln = 0, phibar = 0, cs = -1, sn = 0;

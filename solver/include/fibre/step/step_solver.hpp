@@ -119,7 +119,7 @@ struct StepResult {
   int released = 0; // contacts with zero impulse at the end (lambda_n < 0)
   int capped = 0;   // friction/rolling/twisting rows on their cone boundary
   // Relative residual of the contact conditions at the final lambda (see complementarity()
-  // in contact_solver.cpp): 0 for an exact solution of the nonsmooth step, -1 where it was not
+  // in cones.cpp): 0 for an exact solution of the nonsmooth step, -1 where it was not
   // measured (StepOptions::residual).
   double complementarity = 0;
   int sweeps = 0; // projected Gauss-Seidel sweeps done after the loop, rescue included
