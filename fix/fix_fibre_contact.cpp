@@ -270,6 +270,7 @@ void FixFibreContact::setup(int vflag)
 {
   start_virial(vflag); // no contact forces before the run's first step: a zero virial
   first_step_ = true;
+  skin_warned_ = false;
   detection_->start_moving_walls();
   std::string style;
   const Pair *gran = fibre_lmp::granular_pair(lmp, style);
@@ -494,6 +495,7 @@ void FixFibreContact::final_integrate()
   std::vector<fibre::DetectedContact> found =
       detection_->contacts(bodies, dtv_, model.damping, model.may_bounce() || substeps > 1);
   if (first_step_) warn_deep_overlaps(bodies, found, step_params(bodies, hs).max_recovery);
+  warn_skin();
   first_step_ = false;
   const bool any = output_->count_contacts(found) > 0;
 

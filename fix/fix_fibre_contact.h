@@ -85,6 +85,7 @@ class FixFibreContact : public Fix {
                         const std::vector<fibre::DetectedContact> &found,
                         const fibre::Vector &lambda);
   void tally_virial(const fibre::ContactSystem &sys, const fibre::Vector &lambda);
+  void warn_skin();
   void warn_deep_overlaps(const std::vector<fibre::Body> &bodies,
                           const std::vector<fibre::DetectedContact> &found, double max_recovery);
   fibre::StepResult solve(fibre::ContactSystem &sys, const fibre::Vector &warm,
@@ -105,6 +106,8 @@ class FixFibreContact : public Fix {
   double time_origin_ = 0.0; // simulated time when the fix was defined (moving planes)
   static constexpr double kDeepOverlap = 0.05; // of the smaller diameter: warned at a run's start
   double m_min_ = 0.0, r_min_ = 0.0;
+  double fastest_ = 0.0;     // the step's largest free speed of a sphere (smallest_body)
+  bool skin_warned_ = false; // warn_skin, once a run
   bool first_step_ = true;
   double step_logged_ = 0.0;         // the step whose ratio to the collision time the log states
   int substeps_logged_ = 0;          // and its substeps

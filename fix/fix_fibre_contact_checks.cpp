@@ -228,3 +228,20 @@ void FixFibreContact::warn_deep_overlaps(const std::vector<fibre::Body> &bodies,
                                      " at most (and no faster than the material's spring)"
                                : "none (SPOOK removes any overlap within a few steps)"));
 }
+
+// A sphere that moves farther in a step than the neighbor skin may meet spheres that the
+// list, built at most a step ago, does not hold: it may pass through them. Said once a run.
+void FixFibreContact::warn_skin()
+{
+  const double skin = neighbor->skin, move = fastest_ * dtv_;
+  if (skin_warned_ || !(move > skin) || !(fastest_ > 0)) return;
+  skin_warned_ = true;
+  if (comm->me != 0) return;
+  const auto g = [](double v) { return fibre::format_g(v); };
+  warn(error, FLERR,
+       "Fix fibre_contact: a sphere moves " + g(move) + " in a step (speed " + g(fastest_) +
+           "), more than the neighbor skin " + g(skin) +
+           ": the neighbor list holds no pair farther apart than their radii and the skin, so "
+           "such a sphere may pass through others within a step; raise the skin ('neighbor " +
+           g(1.5 * move) + " bin') or lower the step (below " + g(skin / fastest_) + ")");
+}

@@ -24,17 +24,21 @@ using namespace LAMMPS_NS;
 using fibre_lmp::logmesg;
 
 // The lightest body and the smallest radius of the group over all processes (automatic
-// compliance and recovery speed); the last values stand while the group is empty.
+// compliance and recovery speed); the last values stand while the group is empty. With them,
+// in the same reduction, the largest free speed of the step (fastest_).
 void FixFibreContact::smallest_body(const std::vector<fibre::Body> &bodies)
 {
-  double m[2] = {std::numeric_limits<double>::infinity(), std::numeric_limits<double>::infinity()};
+  double m[3] = {std::numeric_limits<double>::infinity(), std::numeric_limits<double>::infinity(),
+                 0.0};
   for (int k = 0; k < exchange_->num_owned(); ++k) {
     m[0] = std::min(m[0], bodies[k].mass);
     m[1] = std::min(m[1], bodies[k].radius);
+    m[2] = std::min(m[2], -fibre::free_speed(bodies[k], dtv_));
   }
-  MPI_Allreduce(MPI_IN_PLACE, m, 2, MPI_DOUBLE, MPI_MIN, world);
+  MPI_Allreduce(MPI_IN_PLACE, m, 3, MPI_DOUBLE, MPI_MIN, world);
   if (std::isfinite(m[0])) m_min_ = m[0];
   if (std::isfinite(m[1])) r_min_ = m[1];
+  fastest_ = -m[2];
 }
 
 // The contact solve's substeps this step (fibre::substeps_for: automatic from the law's

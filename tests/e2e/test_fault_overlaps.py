@@ -13,6 +13,9 @@ auto. The log's warning names the recovery speed; the pass rule:
 The pair at 20% also on two processes (one sphere each): the same speeds. A lattice of 1694
 spheres (E = 1e7, dt 0.002, gravity) whose bottom layer's centres lie on the floor: none lost
 and none rises faster than the recovery speed, serial and on two processes.
+A sphere at 1e3 m/s onto the floor (E = 7e10), moving 1 a step against a neighbor skin of 0.2:
+the log says that it outruns the skin (no deck above does), and the sphere does not pass the
+floor: it rebounds, its centre always above it.
 """
 
 import re
@@ -70,6 +73,17 @@ thermo 10
 run 300
 """
 
+FAST = "units si\n" + "\n".join(e2e.sphere_box("-5 5 -5 5 -1 2000")) + """
+create_atoms 1 single 0 0 10.3 units box
+velocity all set 0 0 -1000
+""" + SPHERES.format(E="7e10", fix="fix f all fibre_contact wall zplane 0 NULL") + """variable z equal z[1]
+variable vz equal vz[1]
+thermo_style custom step atoms v_z v_vz
+thermo_modify lost warn format float %.15g
+thermo 1
+run 30
+"""
+
 NATIVE_WALL = ("fix f all nve/sphere\nfix w all wall/gran granular " + LAW +
                " zplane 0 NULL")
 
@@ -115,6 +129,7 @@ def main():
                     serial[name] = speed
                     what = "%s %s%% E %s compliance %s" % (kind, 100 * overlap, E, compliance)
                     checks.check(v_rec is not None, what + ": the log names the recovery speed")
+                    checks.check("neighbor skin" not in run.output, what + ": no skin warning")
                     if v_rec is None:
                         continue
                     checks.check(run.last("Atoms") == (2 if kind == "pair" else 1),
@@ -153,6 +168,14 @@ def main():
                      "lattice np %d: none rises faster than the recovery speed" % np,
                      "%.6g against %s" % (speed, v_rec))
         checks.check(e2e.finite(run.column("KinEng")), "lattice np %d: finite" % np)
+    run = e2e.run_lmp(args, FAST, "fast")
+    if checks.ran(run):
+        checks.check("moves 1 in a step (speed 1000), more than the neighbor skin 0.2" in
+                     run.output, "fast sphere: the log says it outruns the skin")
+        checks.check(min(run.column("v_z")) > 0 and run.last("v_vz") > 0,
+                     "fast sphere: rebounds from the floor without passing it",
+                     "lowest centre %.4g, last vz %.4g" % (min(run.column("v_z")),
+                                                           run.last("v_vz")))
     checks.close()
 
 
