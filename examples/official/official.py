@@ -108,6 +108,28 @@ def mixer_figures(run):
             "zc": mean("v_zc"), "zmax": max(r["v_zmax"] for r in rows)}
 
 
+def pour_figures(run):
+    """pour (a chute): spheres at the end, and over the flow (the second run, gravity tilted
+    26 degrees) the mean kinetic and rotational energy, which grow as the flow speeds up."""
+    blocks = run["thermo"]
+    if len(blocks) < 2:
+        return {}
+    rows = blocks[1][1:]
+    mean = lambda key: sum(r[key] for r in rows) / len(rows) if rows else float("nan")  # noqa
+    return {"atoms": blocks[-1][-1]["Atoms"], "ke": mean("KinEng"), "rke": mean("c_1")}
+
+
+def shortened(name, text):
+    """The deck with fewer steps, for the tests (pour: 10000 steps of insertion, 8000 of flow,
+    thermo every 500)."""
+    if name != "pour":
+        return text
+    first = text.index("run\t\t25000")
+    text = text[:first] + "run 10000" + text[first + len("run\t\t25000"):]
+    text = text.replace("run\t\t25000", "run 8000").replace("thermo\t\t1000", "thermo 500")
+    return text
+
+
 def with_drum_figures(text):
     return text + DRUM_FIGURES
 
@@ -134,6 +156,7 @@ DECKS = {
                          mixer_figures),
     "pour.drum": ("lammps", "granular/in.pour.drum", same, with_drum_figures,
                   printed_figures),
+    "pour": ("lammps", "pour/in.pour", same, same, pour_figures),
     "cohesion.noCohesion": ("liggghts", "cohesion/in.noCohesion", same, bed_deck,
                             printed_figures),
     "cohesion.cohesion": ("liggghts", "cohesion/in.cohesion", same, bed_deck, printed_figures),
