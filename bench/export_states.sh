@@ -16,7 +16,7 @@
 #                               [--work /tmp/fibre_states] [--scenes "material silo"]
 #                               [--var NAME VALUE ...]
 # --var passes a deck variable to every run, for example `--var E 1e8` for the states of a
-# stiff material (the decks' fibre step does not depend on E; bench/README.md section 7).
+# stiff material (the decks' time step does not depend on E: it is set at Edt).
 # The states go into the work directory, the runs into <work>/run_<scene><N>/ (their logs:
 # <work>/<scene><N>.log, the exports not kept are deleted). <work>/states.txt lists every
 # state in the work directory: step, simulated time, contacts, bodies (owned), and the

@@ -60,7 +60,7 @@ namespace {
 
 // Each step allocates and frees its buffers (impulses, rows, residuals: hundreds of kB to a few
 // MB). With glibc's defaults the freed memory went back to the system and every step faulted
-// it in again: 40% of the material deck's time (bench/README.md section 4). Freed memory up to
+// it in again: the material deck took 1.8x as long (bench/README.md, "The step's memory"). Freed memory up to
 // 256 MB stays with the process, and blocks below 64 MB come from the heap.
 void keep_step_memory()
 {

@@ -11,8 +11,8 @@ in.janssen.native with seeds 4767, 1031 and 2203: 2,560 spheres filled in 4 batc
 - against the native twin: Janssen's saturation pressure p_sat (the fit of
   p_sat (1 - exp(-(h - z) / lambda)) to the side-wall pressure by height, examples/janssen/
   janssen.py), the deep pressure and the floor's share, each the mean of the three seeds,
-  within 10%. Measured (examples/README.md): the means agreed to 2.8%, 1.0% and 4.2%,
-  and to 6.9%, 1.6% and 3.3% with a build that differs only in round-off. One seed's p_sat scatters by about 9% (standard deviation; fibre 32.8 to 41.9
+  within 10%. Measured (examples/README.md, "Janssen bin"): 1.036, 0.957 and 0.966 of
+  native's. One seed's p_sat scatters by about 9% (standard deviation; fibre 32.8 to 41.9
   over nine runs), so two seeds' mean moved from 1.075 to 1.118 of native's with round-off
   alone: three seeds, the target's own measurement, are compared.
 - on two processes (seed 4767, the fix only), against the serial run of the same seed: the

@@ -47,7 +47,7 @@ struct PgsControl {
   int anderson = 0;
   // Anderson's map is this many sweeps: a mix after every anderson_period sweeps. A mix costs
   // about as much as a sweep (its vectors are memory traffic); mixing after every other sweep
-  // gave the same accuracy for less (doc/design.md, section 6).
+  // gave the same accuracy for less (doc/design.md section 8).
   int anderson_period = 1;
   // Sweeps four contacts at a time (sweep_groups.hpp) where the processor has AVX2 and FMA:
   // the full sweeps and each colour phase, not the focused sweeps' lists.
