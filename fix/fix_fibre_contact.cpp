@@ -60,8 +60,8 @@ namespace {
 
 // Each step allocates and frees its buffers (impulses, rows, residuals: hundreds of kB to a few
 // MB). With glibc's defaults the freed memory went back to the system and every step faulted
-// it in again: the material deck took 1.8x as long (bench/README.md, "The step's memory"). Freed memory up to
-// 256 MB stays with the process, and blocks below 64 MB come from the heap.
+// it in again: the material deck took 1.8x as long (bench/README.md, "The step's memory"). Freed
+// memory up to 256 MB stays with the process, and blocks below 64 MB come from the heap.
 void keep_step_memory()
 {
 #if defined(__GLIBC__)
@@ -118,6 +118,9 @@ FixFibreContact::FixFibreContact(LAMMPS *lmp, int narg, char **arg) : Fix(lmp, n
   } catch (fibre::SettingsError &e) {
     fail(error, FLERR, std::string("Illegal fix fibre_contact command: ") + e.what());
   }
+  if (comm->me == 0)
+    for (const std::string &note : settings_.notes)
+      warn(error, FLERR, "Fix fibre_contact: " + note);
   // the load on each wall: f_ID[w][1..6], force and torque about the origin
   if (!settings_.walls.empty()) {
     array_flag = 1;

@@ -169,6 +169,35 @@ const std::vector<int> &LammpsExchange::ghost_owners() const
   return ghost_owners_;
 }
 
+namespace {
+
+// Per pair of processes that touch a body owned here (this one too where it touches it), how
+// many such bodies: (rank, rank, count) triples, the edges of the process colouring.
+std::vector<int> process_edges(const std::vector<char> &touched,
+                               const std::vector<PointHalo::Link> &shared, int num_owned, int me)
+{
+  std::vector<std::vector<int>> touching(num_owned);
+  for (int k = 0; k < num_owned; ++k)
+    if (touched[k]) touching[k].push_back(me);
+  for (const PointHalo::Link &l : shared)
+    for (const int k : l.bodies)
+      if (touching[k].empty() || touching[k].back() != l.rank) touching[k].push_back(l.rank);
+  std::map<std::pair<int, int>, int> pairs;
+  for (const std::vector<int> &ranks : touching)
+    for (std::size_t i = 0; i < ranks.size(); ++i)
+      for (std::size_t j = i + 1; j < ranks.size(); ++j)
+        ++pairs[{std::min(ranks[i], ranks[j]), std::max(ranks[i], ranks[j])}];
+  std::vector<int> edges;
+  for (const auto &[ranks, bodies] : pairs) {
+    edges.push_back(ranks.first);
+    edges.push_back(ranks.second);
+    edges.push_back(bodies);
+  }
+  return edges;
+}
+
+} // namespace
+
 std::unique_ptr<fibre::Exchange::Halo> LammpsExchange::halo(const std::vector<char> &touched,
                                                             bool colour) const
 {
@@ -229,25 +258,7 @@ std::unique_ptr<fibre::Exchange::Halo> LammpsExchange::halo(const std::vector<ch
   if (!colour)
     return std::make_unique<PointHalo>(halo_comm_, std::move(ghosts), std::move(shared),
                                        std::move(images));
-  // per pair of processes that touch a body owned here (this one too where it touches it),
-  // how many such bodies
-  std::vector<std::vector<int>> touching(num_owned_);
-  for (int k = 0; k < num_owned_; ++k)
-    if (touched[k]) touching[k].push_back(me);
-  for (const Link &l : shared)
-    for (const int k : l.bodies)
-      if (touching[k].empty() || touching[k].back() != l.rank) touching[k].push_back(l.rank);
-  std::map<std::pair<int, int>, int> pairs;
-  for (const std::vector<int> &ranks : touching)
-    for (std::size_t i = 0; i < ranks.size(); ++i)
-      for (std::size_t j = i + 1; j < ranks.size(); ++j)
-        ++pairs[{std::min(ranks[i], ranks[j]), std::max(ranks[i], ranks[j])}];
-  std::vector<int> edges;
-  for (const auto &[ranks, bodies] : pairs) {
-    edges.push_back(ranks.first);
-    edges.push_back(ranks.second);
-    edges.push_back(bodies);
-  }
+  const std::vector<int> edges = process_edges(touched, shared, num_owned_, me);
   const auto [colours, mine] = colour_processes(halo_comm_, nprocs, me, edges);
   return std::make_unique<PointHalo>(halo_comm_, std::move(ghosts), std::move(shared),
                                      std::move(images), colours, mine);

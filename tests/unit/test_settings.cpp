@@ -3,6 +3,10 @@
 // input names the keyword and its expected form.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <fstream>
+#include <map>
+#include <set>
 #include <sstream>
 
 #include "fibre/core/text.hpp"
@@ -277,7 +281,8 @@ TEST(Settings, BadInputNamesTheKeywordAndItsForm)
   EXPECT_TRUE(parse_settings(words("substep_when moving")).model.substep_moving_only);
   EXPECT_FALSE(
       parse_settings(words("substep_when moving substep_when always")).model.substep_moving_only);
-  EXPECT_NE(error_of("speed 3").find("expected a keyword (form, solver"), std::string::npos);
+  EXPECT_NE(error_of("speed 3").find("expected a keyword (wall, compliance"), std::string::npos);
+  EXPECT_NE(error_of("speed 3").find("; tuning: form, precond"), std::string::npos);
   EXPECT_NE(error_of("speed 3").find("got 'speed'"), std::string::npos);
 }
 
@@ -308,4 +313,79 @@ TEST(Settings, MovingPlanes)
             "expected 'wiggle x|y|z <amplitude> <period>' (period > 0), got 'w'");
   EXPECT_EQ(error_of("wall zplane 0 NULL wiggle z 1 0"),
             "expected 'wiggle x|y|z <amplitude> <period>' (period > 0), got '0'");
+}
+
+// The keyword table: every name once, the user tier first, and its error forms as the readers
+// give them.
+TEST(Settings, OneTableOfKeywordsInTwoTiers)
+{
+  const std::vector<KeywordInfo> all = keywords();
+  std::set<std::string> names;
+  bool tuning_seen = false;
+  for (const KeywordInfo &k : all) {
+    EXPECT_TRUE(names.insert(k.name).second) << k.name;
+    if (k.tier == KeywordTier::tuning) tuning_seen = true;
+    EXPECT_FALSE(tuning_seen && k.tier == KeywordTier::user) << k.name << " after a tuning one";
+    EXPECT_FALSE(k.help.empty()) << k.name;
+  }
+  EXPECT_EQ(all.size(), 36u);
+  for (const char *bad : {"tol -1", "linear_tol 0", "anderson 99", "substep_when rest"}) {
+    const std::vector<std::string> w = words(bad);
+    const auto k =
+        std::find_if(all.begin(), all.end(), [&](const KeywordInfo &i) { return i.name == w[0]; });
+    ASSERT_NE(k, all.end());
+    EXPECT_EQ(error_of(bad), "expected " + k->expected + ", got '" + w[1] + "'");
+  }
+}
+
+// The doc page's Syntax lists the table's keywords in the same two tiers.
+TEST(Settings, TheDocPageListsTheTable)
+{
+  std::ifstream in(std::string(FIBRE_TEST_DATA_DIR) + "/../../doc/fix_fibre_contact.md");
+  ASSERT_TRUE(in.good());
+  // "* user keyword (...) = *a*, *b* ..." and its indented continuation lines
+  std::map<std::string, std::set<std::string>> listed; // tier -> names
+  std::string line, tier;
+  while (std::getline(in, line)) {
+    const bool continued = line.rfind("  ", 0) == 0;
+    if (!continued) tier.clear();
+    if (line.rfind("* user keyword", 0) == 0) tier = "user";
+    if (line.rfind("* tuning keyword", 0) == 0) tier = "tuning";
+    if (tier.empty()) continue;
+    const std::size_t from = continued ? 0 : line.find('=');
+    for (std::size_t a = line.find('*', from + 1); a != std::string::npos;) {
+      const std::size_t b = line.find('*', a + 1);
+      if (b == std::string::npos) break;
+      listed[tier].insert(line.substr(a + 1, b - a - 1));
+      a = line.find('*', b + 1);
+    }
+  }
+  std::map<std::string, std::set<std::string>> table;
+  for (const KeywordInfo &k : keywords())
+    table[k.tier == KeywordTier::user ? "user" : "tuning"].insert(k.name);
+  EXPECT_EQ(listed["user"], table["user"]);
+  EXPECT_EQ(listed["tuning"], table["tuning"]);
+}
+
+// A typed tuning keyword that has no effect under the chosen solver is noted for the log.
+TEST(Settings, InertTuningKeywordsAreNoted)
+{
+  const auto notes = [](const char *text) { return parse_settings(words(text)).notes; };
+  const auto noted = [&](const char *text, const std::string &what) {
+    for (const std::string &n : notes(text))
+      if (n.find(what) != std::string::npos) return true;
+    return false;
+  };
+  EXPECT_TRUE(noted("precond tree", "'precond' has no effect"));
+  EXPECT_TRUE(noted("linear_tol 1e-6 maxiter 50", "'maxiter' has no effect"));
+  EXPECT_TRUE(notes("solver cg precond tree linear_tol 1e-6").empty());
+  EXPECT_TRUE(noted("sweep_tol 1e-3", "'sweep_tol' has no effect with a tol"));
+  EXPECT_TRUE(notes("tol none sweep_tol 1e-3").empty());
+  EXPECT_TRUE(noted("tol none min_sweeps 4", "'min_sweeps' has no effect"));
+  EXPECT_TRUE(noted("anderson 0 anderson_period 3", "'anderson_period' has no effect"));
+  EXPECT_TRUE(noted("sweep_cg yes", "deprecated"));
+  EXPECT_TRUE(noted("weight impulse", "'weight' has no effect"));
+  EXPECT_TRUE(notes("solver fbgs weight impulse").empty());
+  EXPECT_TRUE(notes("").empty());
+  EXPECT_TRUE(notes("wall zplane 0 NULL mu 0.3 tol 1e-5 substeps 2").empty());
 }

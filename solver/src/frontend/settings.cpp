@@ -1,5 +1,7 @@
 #include "fibre/frontend/settings.hpp"
 
+#include <algorithm>
+
 #include "fibre/core/text.hpp"
 #include "fibre/step/substeps.hpp"
 
@@ -175,69 +177,63 @@ std::size_t read_wall(const Reader &in, std::size_t i, WallSpec &w)
   return 4 + read_plane_motion(in, i + 4, w);
 }
 
-// The solver keywords; returns the words read, 0 when `key` is not one of them.
-std::size_t read_solver_keyword(const Reader &in, std::size_t i, StepOptions &opt,
-                                bool &sweeps_typed, bool &anderson_typed)
+// What the readers of the keyword table share: the settings, and what the user typed.
+struct ParseState {
+  Settings &s;
+  bool sweeps_typed = false;
+  bool anderson_typed = false;
+};
+
+// Reads keyword args[i] (its expected form given); returns the words read.
+using ReadKeyword = std::size_t (*)(const Reader &in, std::size_t i, const std::string &expected,
+                                    ParseState &st);
+// True where a typed tuning keyword has no effect under these settings.
+using Inert = bool (*)(const Settings &s);
+
+struct Keyword {
+  KeywordInfo info;
+  ReadKeyword read;
+  Inert inert = nullptr;
+  const char *inert_why = ""; // "no effect <why>" in the log
+};
+
+bool linear_pass(const Settings &s)
 {
-  const std::string &key = in.at(i);
-  if (key == "form")
-    opt.form = in.name<Form>(i + 1, key);
-  else if (key == "solver")
-    opt.solver = in.name<Method>(i + 1, key);
-  else if (key == "precond")
-    opt.precond.kind = in.name<PrecondKind>(i + 1, key);
-  else if (key == "weight")
-    opt.precond.weight = in.name<EdgeWeight>(i + 1, key);
-  else if (key == "tol") {
-    const std::string e = "'tol none|<positive number>'";
-    opt.accuracy = in.has(i + 1) && in.at(i + 1) == "none" ? 0.0 : in.positive(i + 1, e);
-  } else if (key == "linear_tol")
-    opt.stop.tol = in.positive(i + 1, "'linear_tol <positive number>'");
-  else if (key == "pass_tol")
-    opt.pass_tol = in.positive(i + 1, "'pass_tol <positive number>'");
-  else if (key == "maxiter")
-    opt.stop.max_iter =
-        static_cast<int>(in.integer(i + 1, "'maxiter <positive integer>'", 1, 100000000));
-  else if (key == "active_set")
-    opt.active_set_max =
-        static_cast<int>(in.integer(i + 1, "'active_set <positive integer>'", 1, 1000));
-  else if (key == "sweeps") {
-    opt.sweeps = static_cast<int>(in.integer(i + 1, "'sweeps <non-negative integer>'", 0, 100000));
-    sweeps_typed = true;
-  } else if (key == "sweep_tol")
-    opt.sweep_tol = in.positive(i + 1, "'sweep_tol <positive number>'");
-  else if (key == "rescue_sweeps")
-    opt.rescue_sweeps =
-        static_cast<int>(in.integer(i + 1, "'rescue_sweeps <non-negative integer>'", 0, 1000000));
-  else if (key == "min_sweeps")
-    opt.min_sweeps =
-        static_cast<int>(in.integer(i + 1, "'min_sweeps <non-negative integer>'", 0, 100000));
-  else if (key == "focus_sweeps")
-    opt.focus_sweeps =
-        static_cast<int>(in.integer(i + 1, "'focus_sweeps <non-negative integer>'", 0, 1000));
-  else if (key == "anderson") {
-    opt.anderson = static_cast<int>(in.integer(i + 1, "'anderson <integer 0 to 50>'", 0, 50));
-    anderson_typed = true;
-  } else if (key == "anderson_period")
-    opt.anderson_period =
-        static_cast<int>(in.integer(i + 1, "'anderson_period <integer 1 to 100>'", 1, 100));
-  else if (key == "sweep_cg")
-    opt.sweep_cg = in.yes_no(i + 1, key);
-  else if (key == "sweep_groups")
-    opt.sweep_groups = in.yes_no(i + 1, key);
-  else if (key == "sweep_blocks")
-    opt.sweep_blocks = in.yes_no(i + 1, key);
-  else
-    return 0;
-  return 2;
+  const Method m = s.step.solver;
+  return !(m == Method::pgs || m == Method::nncg || m == Method::fbgs || m == Method::apgd);
 }
 
-// The contact model's keywords (friction included); 0 when `key` is not one of them.
-// compliance auto|material|<eps_n> <eps_t>
-std::size_t read_compliance(const Reader &in, std::size_t i, Settings &s)
+bool sweeps_only(const Settings &s)
 {
-  const std::string e =
-      "'compliance auto|material' or 'compliance <eps_n> <eps_t>' (positive numbers)";
+  return !linear_pass(s);
+}
+
+std::string quoted(const std::string &key, const std::string &form)
+{
+  return "'" + key + " " + form + "'";
+}
+
+template <class E> std::string enum_form(const std::string &key)
+{
+  return quoted(key, choices<E>());
+}
+
+double non_negative(const Reader &in, std::size_t i, const std::string &e)
+{
+  const double v = in.number(i, e);
+  if (!(v >= 0.0)) Reader::illegal(e, &in.at(i));
+  return v;
+}
+
+int count(const Reader &in, std::size_t i, const std::string &e, long lo, long hi)
+{
+  return static_cast<int>(in.integer(i, e, lo, hi));
+}
+
+// compliance auto|material|<eps_n> <eps_t>
+std::size_t read_compliance(const Reader &in, std::size_t i, const std::string &e, ParseState &st)
+{
+  Settings &s = st.s;
   if (!in.has(i + 1)) Reader::illegal(e);
   s.model.typed.compliance = true;
   if (in.at(i + 1) == "auto" || in.at(i + 1) == "material") {
@@ -254,164 +250,372 @@ std::size_t read_compliance(const Reader &in, std::size_t i, Settings &s)
   return 3;
 }
 
-// recovery_speed and bounce_speed: auto, a speed (recovery_speed also none)
-std::size_t read_speed_keyword(const Reader &in, std::size_t i, Settings &s)
+std::size_t read_friction(const Reader &in, std::size_t i, const std::string &e, ParseState &st)
 {
   const std::string &key = in.at(i);
-  if (key == "recovery_speed") {
-    const std::string e = "'recovery_speed auto|none|<positive speed>'";
-    if (!in.has(i + 1)) Reader::illegal(e);
-    const std::string &v = in.at(i + 1);
-    if (v == "auto")
-      s.model.recovery_speed = -1.0;
-    else if (v == "none")
-      s.model.recovery_speed = 0.0;
-    else
-      s.model.recovery_speed = in.positive(i + 1, e);
-    return 2;
-  }
-  if (key == "bounce_speed") {
-    const std::string e = "'bounce_speed auto|<non-negative speed>'";
-    if (!in.has(i + 1)) Reader::illegal(e);
-    if (in.at(i + 1) == "auto") {
-      s.model.bounce_speed = -1.0;
-      return 2;
-    }
-    const double v = in.number(i + 1, e);
-    if (!(v >= 0.0)) Reader::illegal(e, &in.at(i + 1));
-    s.model.bounce_speed = v;
-    return 2;
-  }
-  return 0;
+  const double v = non_negative(in, i + 1, e);
+  FrictionParams &f = st.s.model.friction;
+  TypedCoefficients &typed = st.s.model.typed;
+  (key == "mu" ? f.mu : key == "mu_roll" ? f.mu_roll : f.mu_twist) = v;
+  (key == "mu" ? typed.mu : key == "mu_roll" ? typed.mu_roll : typed.mu_twist) = true;
+  return 2;
 }
 
-// substeps, substep_when, substep_collisions
-std::size_t read_substep_keyword(const Reader &in, std::size_t i, Settings &s)
+std::size_t read_wall_keyword(const Reader &in, std::size_t i, const std::string &, ParseState &st)
 {
-  const std::string &key = in.at(i);
-  if (key == "substeps") {
-    const std::string e = "'substeps auto|<integer 1 to " + std::to_string(kMaxSubsteps) + ">'";
-    if (!in.has(i + 1)) Reader::illegal(e);
-    s.model.substeps =
-        in.at(i + 1) == "auto" ? 0 : static_cast<int>(in.integer(i + 1, e, 1, kMaxSubsteps));
-    return 2;
-  }
-  if (key == "substep_when") {
-    const std::string e = "'substep_when always|moving'";
-    if (!in.has(i + 1)) Reader::illegal(e);
-    if (in.at(i + 1) != "always" && in.at(i + 1) != "moving") Reader::illegal(e, &in.at(i + 1));
-    s.model.substep_moving_only = in.at(i + 1) == "moving";
-    return 2;
-  }
-  if (key == "substep_collisions") {
-    s.model.substep_collisions =
-        in.positive(i + 1, "'substep_collisions <positive number of collision times>'");
-    return 2;
-  }
-  return 0;
+  WallSpec w;
+  const std::size_t used = read_wall(in, i, w);
+  st.s.walls.push_back(w);
+  return used;
 }
 
-std::size_t read_model_keyword(const Reader &in, std::size_t i, Settings &s)
+// The keywords a DEM deck sets.
+std::vector<Keyword> user_keywords()
 {
-  const std::string &key = in.at(i);
-  if (key == "compliance") return read_compliance(in, i, s);
-  if (key == "recovery_speed" || key == "bounce_speed") return read_speed_keyword(in, i, s);
-  if (key == "substeps" || key == "substep_when" || key == "substep_collisions")
-    return read_substep_keyword(in, i, s);
-  if (key == "damping") {
-    s.model.damping = in.positive(i + 1, "'damping <positive number of steps>'");
-    return 2;
-  }
-  if (key == "mu" || key == "mu_roll" || key == "mu_twist") {
-    const std::string e = "'" + key + " <non-negative number>'";
-    const double v = in.number(i + 1, e);
-    if (!(v >= 0.0)) Reader::illegal(e, &in.at(i + 1));
-    FrictionParams &f = s.model.friction;
-    TypedCoefficients &typed = s.model.typed;
-    (key == "mu" ? f.mu : key == "mu_roll" ? f.mu_roll : f.mu_twist) = v;
-    (key == "mu" ? typed.mu : key == "mu_roll" ? typed.mu_roll : typed.mu_twist) = true;
-    return 2;
-  }
-  if (key == "restitution") {
-    const std::string e = "'restitution <number in [0, 1]>'";
-    const double v = in.number(i + 1, e);
-    if (!(v >= 0.0 && v <= 1.0)) Reader::illegal(e, &in.at(i + 1));
-    s.model.restitution = v;
-    s.model.typed.restitution = true;
-    return 2;
-  }
-  if (key == "coefficients") {
-    s.model.coefficients = in.name<CoefficientSource>(i + 1, key);
-    return 2;
-  }
-  if (key == "normal_relaxation") {
-    s.model.normal_relaxation = in.name<NormalRelaxation>(i + 1, key);
-    return 2;
-  }
-  if (key == "rows") {
-    const std::string e = "'rows 3|6'";
-    long v = 0;
-    if (!in.has(i + 1)) Reader::illegal(e);
-    if (!to_long(in.at(i + 1), v) || (v != 3 && v != 6)) Reader::illegal(e, &in.at(i + 1));
-    s.model.rows = static_cast<int>(v);
-    return 2;
-  }
-  return 0;
+  const KeywordTier U = KeywordTier::user;
+  const std::string substeps = "auto|<integer 1 to " + std::to_string(kMaxSubsteps) + ">";
+  return {
+      {{"wall", U, "'wall [type <T> | <interaction>] <style> <args>'", "a wall (repeatable)"},
+       read_wall_keyword},
+      {{"compliance", U,
+        "'compliance auto|material' or 'compliance <eps_n> <eps_t>' (positive numbers)",
+        "the rows' compliance: the material's laws, rigid, or given"},
+       read_compliance},
+      {{"recovery_speed", U, quoted("recovery_speed", "auto|none|<positive speed>"),
+        "the largest speed at which overlaps are removed"},
+       [](const Reader &in, std::size_t i, const std::string &e, ParseState &st) -> std::size_t {
+         if (!in.has(i + 1)) Reader::illegal(e);
+         const std::string &v = in.at(i + 1);
+         st.s.model.recovery_speed = v == "auto" ? -1.0 : v == "none" ? 0.0 : in.positive(i + 1, e);
+         return 2;
+       }},
+      {{"restitution", U, quoted("restitution", "<number in [0, 1]>"),
+        "Newton's restitution of every contact"},
+       [](const Reader &in, std::size_t i, const std::string &e, ParseState &st) -> std::size_t {
+         const double v = in.number(i + 1, e);
+         if (!(v >= 0.0 && v <= 1.0)) Reader::illegal(e, &in.at(i + 1));
+         st.s.model.restitution = v;
+         st.s.model.typed.restitution = true;
+         return 2;
+       }},
+      {{"substeps", U, quoted("substeps", substeps), "the contact solve's substeps a step"},
+       [](const Reader &in, std::size_t i, const std::string &e, ParseState &st) -> std::size_t {
+         if (!in.has(i + 1)) Reader::illegal(e);
+         st.s.model.substeps = in.at(i + 1) == "auto" ? 0 : count(in, i + 1, e, 1, kMaxSubsteps);
+         return 2;
+       }},
+      {{"tol", U, quoted("tol", "none|<positive number>"), "the step's accuracy"},
+       [](const Reader &in, std::size_t i, const std::string &e, ParseState &st) -> std::size_t {
+         const bool none = in.has(i + 1) && in.at(i + 1) == "none";
+         st.s.step.accuracy = none ? 0.0 : in.positive(i + 1, e);
+         return 2;
+       }},
+      {{"mu", U, quoted("mu", "<non-negative number>"), "Coulomb friction"}, read_friction},
+      {{"mu_roll", U, quoted("mu_roll", "<non-negative number>"), "rolling resistance"},
+       read_friction},
+      {{"mu_twist", U, quoted("mu_twist", "<non-negative number>"), "twisting resistance"},
+       read_friction},
+      {{"coefficients", U, enum_form<CoefficientSource>("coefficients"),
+        "friction and restitution from the pair style or this fix"},
+       [](const Reader &in, std::size_t i, const std::string &, ParseState &st) -> std::size_t {
+         st.s.model.coefficients = in.name<CoefficientSource>(i + 1, in.at(i));
+         return 2;
+       }},
+      {{"rows", U, "'rows 3|6'", "3: normal and tangential rows; 6: with rolling and twisting"},
+       [](const Reader &in, std::size_t i, const std::string &e, ParseState &st) -> std::size_t {
+         long v = 0;
+         if (!in.has(i + 1)) Reader::illegal(e);
+         if (!to_long(in.at(i + 1), v) || (v != 3 && v != 6)) Reader::illegal(e, &in.at(i + 1));
+         st.s.model.rows = static_cast<int>(v);
+         return 2;
+       }},
+      {{"check", U, "'check <N>' (N a non-negative integer)",
+        "every N steps, the step's error against the converged step"},
+       [](const Reader &in, std::size_t i, const std::string &e, ParseState &st) -> std::size_t {
+         st.s.check_every = count(in, i + 1, e, 0, 2000000000L);
+         return 2;
+       }},
+      {{"export", U, "'export <N> <file-prefix>' (N a positive integer)",
+        "every N steps, the contact system to files"},
+       [](const Reader &in, std::size_t i, const std::string &e, ParseState &st) -> std::size_t {
+         st.s.export_every = count(in, i + 1, e, 1, 2000000000L);
+         if (!in.has(i + 2)) Reader::illegal(e);
+         st.s.export_prefix = in.at(i + 2);
+         return 3;
+       }},
+      {{"solver", U, enum_form<Method>("solver"), "the contact solver"},
+       [](const Reader &in, std::size_t i, const std::string &, ParseState &st) -> std::size_t {
+         st.s.step.solver = in.name<Method>(i + 1, in.at(i));
+         return 2;
+       }},
+  };
 }
 
-} // namespace
+constexpr const char *kLinearOnly =
+    "outside the linear pass of solver cg, cr, minres or direct (this solver has none)";
 
-Settings parse_settings(const std::vector<std::string> &args)
+// The tuning keywords of the linear pass (solver cg, cr, minres, direct).
+std::vector<Keyword> linear_keywords()
 {
-  Settings s;
-  const Reader in(args);
-  std::size_t i = 0;
-  bool sweeps_typed = false, anderson_typed = false;
-  while (i < args.size()) {
-    const std::string &key = args[i];
-    std::size_t used = read_solver_keyword(in, i, s.step, sweeps_typed, anderson_typed);
-    if (!used) used = read_model_keyword(in, i, s);
-    if (!used && key == "wall") {
-      WallSpec w;
-      used = read_wall(in, i, w);
-      s.walls.push_back(w);
+  const KeywordTier T = KeywordTier::tuning;
+  return {
+      {{"form", T, enum_form<Form>("form"), "the linear pass's unknowns: bodies or impulses"},
+       [](const Reader &in, std::size_t i, const std::string &, ParseState &st) -> std::size_t {
+         st.s.step.form = in.name<Form>(i + 1, in.at(i));
+         return 2;
+       },
+       sweeps_only,
+       kLinearOnly},
+      {{"precond", T, enum_form<PrecondKind>("precond"), "the Krylov solvers' preconditioner"},
+       [](const Reader &in, std::size_t i, const std::string &, ParseState &st) -> std::size_t {
+         st.s.step.precond.kind = in.name<PrecondKind>(i + 1, in.at(i));
+         return 2;
+       },
+       sweeps_only,
+       kLinearOnly},
+      {{"weight", T, enum_form<EdgeWeight>("weight"), "the order in which fibres and trees grow"},
+       [](const Reader &in, std::size_t i, const std::string &, ParseState &st) -> std::size_t {
+         st.s.step.precond.weight = in.name<EdgeWeight>(i + 1, in.at(i));
+         return 2;
+       },
+       [](const Settings &s) {
+         const PrecondKind k = s.step.precond.kind;
+         const bool grown = linear_pass(s) && (k == PrecondKind::fibre || k == PrecondKind::tree);
+         return !grown && s.step.solver != Method::fbgs && !s.step.sweep_blocks;
+       },
+       "without fibres or trees (precond fibre or tree of a linear pass, solver fbgs)"},
+      {{"linear_tol", T, quoted("linear_tol", "<positive number>"), "a linear solve's tolerance"},
+       [](const Reader &in, std::size_t i, const std::string &e, ParseState &st) -> std::size_t {
+         st.s.step.stop.tol = in.positive(i + 1, e);
+         return 2;
+       },
+       sweeps_only,
+       kLinearOnly},
+      {{"pass_tol", T, quoted("pass_tol", "<positive number>"),
+        "the set-deciding passes' tolerance"},
+       [](const Reader &in, std::size_t i, const std::string &e, ParseState &st) -> std::size_t {
+         st.s.step.pass_tol = in.positive(i + 1, e);
+         return 2;
+       },
+       sweeps_only,
+       kLinearOnly},
+      {{"maxiter", T, quoted("maxiter", "<positive integer>"), "a linear solve's iterations"},
+       [](const Reader &in, std::size_t i, const std::string &e, ParseState &st) -> std::size_t {
+         st.s.step.stop.max_iter = count(in, i + 1, e, 1, 100000000);
+         return 2;
+       },
+       sweeps_only,
+       kLinearOnly},
+      {{"active_set", T, quoted("active_set", "<positive integer>"), "the active-set passes"},
+       [](const Reader &in, std::size_t i, const std::string &e, ParseState &st) -> std::size_t {
+         st.s.step.active_set_max = count(in, i + 1, e, 1, 1000);
+         return 2;
+       },
+       sweeps_only,
+       kLinearOnly},
+      {{"rescue_sweeps", T, quoted("rescue_sweeps", "<non-negative integer>"),
+        "the sweeps of a step left far from sweep_tol"},
+       [](const Reader &in, std::size_t i, const std::string &e, ParseState &st) -> std::size_t {
+         st.s.step.rescue_sweeps = count(in, i + 1, e, 0, 1000000);
+         return 2;
+       },
+       [](const Settings &s) { return sweeps_only(s) || s.step.accuracy > 0; },
+       "outside a linear pass with tol none"},
+  };
+}
+
+// The tuning keywords of the sweeps.
+std::vector<Keyword> sweep_keywords()
+{
+  const KeywordTier T = KeywordTier::tuning;
+  return {
+      {{"sweeps", T, quoted("sweeps", "<non-negative integer>"), "the most sweeps of a step"},
+       [](const Reader &in, std::size_t i, const std::string &e, ParseState &st) -> std::size_t {
+         st.s.step.sweeps = count(in, i + 1, e, 0, 100000);
+         st.sweeps_typed = true;
+         return 2;
+       }},
+      {{"sweep_tol", T, quoted("sweep_tol", "<positive number>"),
+        "the complementarity residual the sweeps aim at"},
+       [](const Reader &in, std::size_t i, const std::string &e, ParseState &st) -> std::size_t {
+         st.s.step.sweep_tol = in.positive(i + 1, e);
+         return 2;
+       },
+       [](const Settings &s) { return s.step.accuracy > 0; },
+       "with a tol (the sweeps stop on its error estimate; tol none stops them on sweep_tol)"},
+      {{"min_sweeps", T, quoted("min_sweeps", "<non-negative integer>"),
+        "the sweeps before a tol may stop them"},
+       [](const Reader &in, std::size_t i, const std::string &e, ParseState &st) -> std::size_t {
+         st.s.step.min_sweeps = count(in, i + 1, e, 0, 100000);
+         return 2;
+       },
+       [](const Settings &s) { return !(s.step.accuracy > 0); },
+       "with tol none"},
+      {{"focus_sweeps", T, quoted("focus_sweeps", "<non-negative integer>"),
+        "the sweeps over only the contacts the last full one moved"},
+       [](const Reader &in, std::size_t i, const std::string &e, ParseState &st) -> std::size_t {
+         st.s.step.focus_sweeps = count(in, i + 1, e, 0, 1000);
+         return 2;
+       }},
+      {{"anderson", T, quoted("anderson", "<integer 0 to 50>"), "Anderson acceleration's depth"},
+       [](const Reader &in, std::size_t i, const std::string &e, ParseState &st) -> std::size_t {
+         st.s.step.anderson = count(in, i + 1, e, 0, 50);
+         st.anderson_typed = true;
+         return 2;
+       }},
+      {{"anderson_period", T, quoted("anderson_period", "<integer 1 to 100>"),
+        "the sweeps of Anderson's map"},
+       [](const Reader &in, std::size_t i, const std::string &e, ParseState &st) -> std::size_t {
+         st.s.step.anderson_period = count(in, i + 1, e, 1, 100);
+         return 2;
+       },
+       [](const Settings &s) { return s.step.anderson == 0; },
+       "without Anderson acceleration"},
+      {{"sweep_groups", T, "'sweep_groups yes|no'", "four contacts at a time (AVX2)"},
+       [](const Reader &in, std::size_t i, const std::string &, ParseState &st) -> std::size_t {
+         st.s.step.sweep_groups = in.yes_no(i + 1, in.at(i));
+         return 2;
+       }},
+      {{"sweep_cg", T, "'sweep_cg yes|no'", "deprecated: solver nncg"},
+       [](const Reader &in, std::size_t i, const std::string &, ParseState &st) -> std::size_t {
+         st.s.step.sweep_cg = in.yes_no(i + 1, in.at(i));
+         return 2;
+       },
+       [](const Settings &) { return true; },
+       "of its own: it is deprecated, and 'solver nncg' gives the same sweeps"},
+      {{"sweep_blocks", T, "'sweep_blocks yes|no'", "deprecated: solver fbgs"},
+       [](const Reader &in, std::size_t i, const std::string &, ParseState &st) -> std::size_t {
+         st.s.step.sweep_blocks = in.yes_no(i + 1, in.at(i));
+         return 2;
+       },
+       [](const Settings &) { return true; },
+       "of its own: it is deprecated, and 'solver fbgs' gives the same sweeps"},
+  };
+}
+
+// The tuning keywords of the contact model and the substeps.
+std::vector<Keyword> model_keywords()
+{
+  const KeywordTier T = KeywordTier::tuning;
+  return {
+      {{"damping", T, quoted("damping", "<positive number of steps>"),
+        "the constraints' relaxation time in steps"},
+       [](const Reader &in, std::size_t i, const std::string &e, ParseState &st) -> std::size_t {
+         st.s.model.damping = in.positive(i + 1, e);
+         return 2;
+       }},
+      {{"bounce_speed", T, quoted("bounce_speed", "auto|<non-negative speed>"),
+        "the approach speed below which contacts stay plastic"},
+       [](const Reader &in, std::size_t i, const std::string &e, ParseState &st) -> std::size_t {
+         if (!in.has(i + 1)) Reader::illegal(e);
+         st.s.model.bounce_speed = in.at(i + 1) == "auto" ? -1.0 : non_negative(in, i + 1, e);
+         return 2;
+       }},
+      {{"normal_relaxation", T, enum_form<NormalRelaxation>("normal_relaxation"),
+        "a loaded material row's relaxation"},
+       [](const Reader &in, std::size_t i, const std::string &, ParseState &st) -> std::size_t {
+         st.s.model.normal_relaxation = in.name<NormalRelaxation>(i + 1, in.at(i));
+         return 2;
+       }},
+      {{"substep_collisions", T,
+        quoted("substep_collisions", "<positive number of collision times>"),
+        "the longest substep of substeps auto"},
+       [](const Reader &in, std::size_t i, const std::string &e, ParseState &st) -> std::size_t {
+         st.s.model.substep_collisions = in.positive(i + 1, e);
+         return 2;
+       }},
+      {{"substep_when", T, "'substep_when always|moving'", "one solve where nothing moves"},
+       [](const Reader &in, std::size_t i, const std::string &e, ParseState &st) -> std::size_t {
+         if (!in.has(i + 1)) Reader::illegal(e);
+         if (in.at(i + 1) != "always" && in.at(i + 1) != "moving")
+           Reader::illegal(e, &in.at(i + 1));
+         st.s.model.substep_moving_only = in.at(i + 1) == "moving";
+         return 2;
+       }},
+  };
+}
+
+const std::vector<Keyword> &table()
+{
+  static const std::vector<Keyword> all = [] {
+    std::vector<Keyword> t = user_keywords();
+    for (auto part : {linear_keywords, sweep_keywords, model_keywords}) {
+      std::vector<Keyword> more = part();
+      t.insert(t.end(), more.begin(), more.end());
     }
-    if (!used && key == "export") {
-      const std::string e = "'export <N> <file-prefix>' (N a positive integer)";
-      s.export_every = static_cast<int>(in.integer(i + 1, e, 1, 2000000000L));
-      if (!in.has(i + 2)) Reader::illegal(e);
-      s.export_prefix = args[i + 2];
-      used = 3;
-    }
-    if (!used && key == "check") {
-      s.check_every = static_cast<int>(
-          in.integer(i + 1, "'check <N>' (N a non-negative integer)", 0, 2000000000L));
-      used = 2;
-    }
-    if (!used)
-      Reader::illegal(
-          "a keyword (form, solver, precond, weight, tol, linear_tol, pass_tol, maxiter, "
-          "compliance, damping, mu, mu_roll, mu_twist, rows, active_set, sweeps, "
-          "sweep_tol, rescue_sweeps, min_sweeps, focus_sweeps, anderson, anderson_period, "
-          "sweep_cg, sweep_blocks, sweep_groups, recovery_speed, restitution, bounce_speed, "
-          "coefficients, normal_relaxation, substeps, substep_collisions, substep_when, wall, "
-          "export, check)",
-          &key);
-    i += used;
+    return t;
+  }();
+  return all;
+}
+
+const Keyword *find_keyword(const std::string &name)
+{
+  for (const Keyword &k : table())
+    if (k.info.name == name) return &k;
+  return nullptr;
+}
+
+std::string names_of(KeywordTier tier)
+{
+  std::string out;
+  for (const Keyword &k : table())
+    if (k.info.tier == tier) out += (out.empty() ? "" : ", ") + k.info.name;
+  return out;
+}
+
+// The log's notes on typed tuning keywords that have no effect under the settings.
+void note_inert(const std::vector<std::string> &typed, Settings &s)
+{
+  for (const Keyword &k : table()) {
+    if (!k.inert || std::find(typed.begin(), typed.end(), k.info.name) == typed.end()) continue;
+    if (k.inert(s)) s.notes.push_back("'" + k.info.name + "' has no effect " + k.inert_why);
   }
+}
+
+// The rules between keywords, after all are read.
+void finish_settings(const ParseState &st, Settings &s)
+{
   // a step accuracy needs room to reach it; a fast step (tol none) stops at its cap
-  if (!sweeps_typed) s.step.sweeps = s.step.accuracy > 0 ? kAccuracySweeps : kFastSweeps;
+  if (!st.sweeps_typed) s.step.sweeps = s.step.accuracy > 0 ? kAccuracySweeps : kFastSweeps;
   StepOptions &o = s.step;
   const bool plain =
       !(o.solver == Method::nncg || o.solver == Method::apgd || o.solver == Method::fbgs ||
         o.sweep_cg || o.sweep_blocks || o.focus_sweeps > 0);
-  if (!plain && !anderson_typed) o.anderson = 0; // the default accelerates plain sweeps only
+  if (!plain && !st.anderson_typed) o.anderson = 0; // the default accelerates plain sweeps only
   if (!plain && o.anderson > 0)
     throw SettingsError("anderson accelerates plain sweeps: not with solver nncg, apgd or fbgs, "
                         "sweep_cg yes, sweep_blocks yes, or focus_sweeps");
   const FrictionParams &f = s.model.friction;
   if (s.model.rows == 3 && (f.mu_roll > 0.0 || f.mu_twist > 0.0))
     throw SettingsError("mu_roll and mu_twist need 'rows 6' (rows 3 has no rotational rows)");
+}
+
+} // namespace
+
+std::vector<KeywordInfo> keywords()
+{
+  std::vector<KeywordInfo> out;
+  for (const Keyword &k : table()) out.push_back(k.info);
+  return out;
+}
+
+Settings parse_settings(const std::vector<std::string> &args)
+{
+  Settings s;
+  ParseState st{s};
+  const Reader in(args);
+  std::vector<std::string> typed;
+  for (std::size_t i = 0; i < args.size();) {
+    const Keyword *k = find_keyword(args[i]);
+    if (!k)
+      Reader::illegal("a keyword (" + names_of(KeywordTier::user) +
+                          "; tuning: " + names_of(KeywordTier::tuning) + ")",
+                      &args[i]);
+    typed.push_back(args[i]);
+    i += k->read(in, i, k->info.expected, st);
+  }
+  finish_settings(st, s);
+  note_inert(typed, s);
   return s;
 }
 

@@ -132,6 +132,26 @@ Vec3 closest_point_on_triangle(const Vec3 &x, const Vec3 &a, const Vec3 &b, cons
   return set(u / sum, v / sum, w / sum, TriangleFeature::face);
 }
 
+namespace {
+
+// The grid's cell: the given one, else about one triangle across (its middle extent, mean_size),
+// which keeps both the lists and the cells scanned per query short; grown until the grid has
+// at most TriangleGrid::kMaxCells cells.
+double grid_cell(double cell, double mean_size, const Vec3 &extent)
+{
+  if (!(cell > 0.0) || !std::isfinite(cell)) cell = mean_size;
+  if (!(cell > 0.0)) cell = extent.maxCoeff();
+  if (!(cell > 0.0)) cell = 1.0; // all triangles are one point
+  for (;;) {
+    double total = 1.0;
+    for (int d = 0; d < 3; ++d) total *= std::floor(extent[d] / cell) + 1.0;
+    if (total <= TriangleGrid::kMaxCells) return cell;
+    cell *= std::max(1.01, std::cbrt(total / TriangleGrid::kMaxCells));
+  }
+}
+
+} // namespace
+
 void TriangleGrid::build(const std::vector<Triangle> &tris, double cell)
 {
   const int n = static_cast<int>(tris.size());
@@ -163,19 +183,8 @@ void TriangleGrid::build(const std::vector<Triangle> &tris, double cell)
   lo_ = lo;
   hi_ = hi;
 
-  // Cells about one triangle across (its middle extent) keep both the lists and the cells
-  // scanned per query short.
-  if (!(cell > 0.0) || !std::isfinite(cell)) cell = size_sum / finite;
-  if (!(cell > 0.0)) cell = (hi - lo).maxCoeff();
-  if (!(cell > 0.0)) cell = 1.0; // all triangles are one point
   const Vec3 extent = hi - lo;
-  double total = 0.0;
-  for (;;) {
-    total = 1.0;
-    for (int d = 0; d < 3; ++d) total *= std::floor(extent[d] / cell) + 1.0;
-    if (total <= kMaxCells) break;
-    cell *= std::max(1.01, std::cbrt(total / kMaxCells));
-  }
+  cell = grid_cell(cell, size_sum / finite, extent);
   cell_ = cell;
   for (int d = 0; d < 3; ++d) dims_[d] = static_cast<int>(std::floor(extent[d] / cell)) + 1;
 

@@ -240,6 +240,67 @@ FIBRE_AVX2 void body_impulse(const __m256d r[3], const __m256d f[3], const __m25
   y[5] = _mm256_add_pd(_mm256_fmsub_pd(r[0], f[1], _mm256_mul_pd(r[1], f[0])), m[2]);
 }
 
+// u = D t: a velocity t in the contact's frame (D's rows n, t1, t2).
+FIBRE_AVX2 void frame_rows(const __m256d D[9], __m256d t0, __m256d t1, __m256d t2, __m256d u[3])
+{
+  for (int i = 0; i < 3; ++i)
+    u[i] = _mm256_fmadd_pd(D[i + 6], t2, _mm256_fmadd_pd(D[i + 3], t1, _mm256_mul_pd(D[i], t0)));
+}
+
+// lambda_n >= 0 (NaN and infinity to 0), then each cone (Cones::project_rows) of four
+// contacts' rows x, whose packed data starts at p.
+template <int R> FIBRE_AVX2 void project_lanes(const double *p, __m256d x[R])
+{
+  using V = __m256d;
+  const V zero = _mm256_setzero_pd(), inf = _mm256_set1_pd(INFINITY), one = _mm256_set1_pd(1.0);
+  x[0] = _mm256_and_pd(
+      _mm256_and_pd(_mm256_cmp_pd(x[0], zero, _CMP_GT_OQ), _mm256_cmp_pd(x[0], inf, _CMP_LT_OQ)),
+      x[0]);
+  for (int k = 0; k < num_cones(R); ++k) {
+    const int first = kCones[k].first;
+    const bool pair = kCones[k].size == 2;
+    const V radius = _mm256_mul_pd(_mm256_loadu_pd(p + kGroupLanes * (kCoeff + k)), x[0]);
+    V tn2 = _mm256_mul_pd(x[first], x[first]);
+    if (pair) tn2 = _mm256_fmadd_pd(x[first + 1], x[first + 1], tn2);
+    // inside: unchanged; outside: shrunk onto the cone; no cone or a non-finite norm: zero
+    const V keep =
+        _mm256_and_pd(_mm256_cmp_pd(radius, zero, _CMP_GT_OQ), _mm256_cmp_pd(tn2, inf, _CMP_LT_OQ));
+    const V outside = _mm256_cmp_pd(tn2, _mm256_mul_pd(radius, radius), _CMP_GT_OQ);
+    const V shrink = _mm256_blendv_pd(one, _mm256_div_pd(radius, _mm256_sqrt_pd(tn2)), outside);
+    x[first] = _mm256_and_pd(keep, _mm256_mul_pd(x[first], shrink));
+    if (pair) x[first + 1] = _mm256_and_pd(keep, _mm256_mul_pd(x[first + 1], shrink));
+  }
+}
+
+// The bodies' velocities after a change delta of four contacts' rows: G^T delta
+// (contact_impulse), f = D^T delta_t, m = D^T delta_r, y_a = [f; ra x f + m], y_b = -[f; rb x f +
+// m]; then w += M^-1 y.
+template <int R>
+FIBRE_AVX2 void add_change(const double *p, const __m256d D[9], const __m256d ra[3],
+                           const __m256d rb[3], const __m256d delta[R], __m256d va[6],
+                           __m256d vb[6])
+{
+  using V = __m256d;
+  const V zero = _mm256_setzero_pd();
+  V f[3], m[3] = {zero, zero, zero};
+  for (int k = 0; k < 3; ++k) {
+    f[k] =
+        _mm256_fmadd_pd(D[3 * k + 2], delta[2],
+                        _mm256_fmadd_pd(D[3 * k + 1], delta[1], _mm256_mul_pd(D[3 * k], delta[0])));
+    if constexpr (R == 6)
+      m[k] = _mm256_fmadd_pd(
+          D[3 * k + 2], delta[5],
+          _mm256_fmadd_pd(D[3 * k + 1], delta[4], _mm256_mul_pd(D[3 * k], delta[3])));
+  }
+  V ya[6], yb[6];
+  body_impulse(ra, f, m, ya);
+  body_impulse(rb, f, m, yb);
+  for (int d = 0; d < 6; ++d) {
+    va[d] = _mm256_fmadd_pd(_mm256_loadu_pd(p + kGroupLanes * (kMassA + d)), ya[d], va[d]);
+    vb[d] = _mm256_fnmadd_pd(_mm256_loadu_pd(p + kGroupLanes * (kMassB + d)), yb[d], vb[d]);
+  }
+}
+
 // The sweep over the groups (pgs.cpp's sweep<R>, four contacts a step). An empty lane reads
 // and writes zeros in `spare` (its packed data is zero); a wall's side reads and writes the
 // spare body (its inverse mass is zero).
@@ -250,7 +311,7 @@ sweep_groups(const double *pack, const int *contact, const int *body_a, const in
 {
   using V = __m256d;
   alignas(32) double spare_body[6] = {0, 0, 0, 0, 0, 0}, spare_rows[6] = {0, 0, 0, 0, 0, 0};
-  const V zero = _mm256_setzero_pd(), inf = _mm256_set1_pd(INFINITY), one = _mm256_set1_pd(1.0);
+  const V zero = _mm256_setzero_pd();
   V change2 = zero, size2 = zero;
   for (int g = 0; g < groups; ++g) {
     const double *p = pack + std::size_t(g) * kFields * kGroupLanes;
@@ -277,15 +338,10 @@ sweep_groups(const double *pack, const int *contact, const int *body_a, const in
     V D[9];
     for (int i = 0; i < 9; ++i) D[i] = FIBRE_FIELD(kFrame + i);
     V u[6];
-    for (int i = 0; i < 3; ++i)
-      u[i] = _mm256_fmadd_pd(D[i + 6], t2, _mm256_fmadd_pd(D[i + 3], t1, _mm256_mul_pd(D[i], t0)));
-    if constexpr (R == 6) {
-      const V o0 = _mm256_sub_pd(va[3], vb[3]), o1 = _mm256_sub_pd(va[4], vb[4]),
-              o2 = _mm256_sub_pd(va[5], vb[5]);
-      for (int i = 0; i < 3; ++i)
-        u[3 + i] =
-            _mm256_fmadd_pd(D[i + 6], o2, _mm256_fmadd_pd(D[i + 3], o1, _mm256_mul_pd(D[i], o0)));
-    }
+    frame_rows(D, t0, t1, t2, u);
+    if constexpr (R == 6)
+      frame_rows(D, _mm256_sub_pd(va[3], vb[3]), _mm256_sub_pd(va[4], vb[4]),
+                 _mm256_sub_pd(va[5], vb[5]), u + 3);
     // x = old + (b - u - Sigma old) / scale, then lambda_n >= 0 (NaN and infinity to 0) and
     // each cone (Cones::project_rows)
     V old[R], x[R], delta[R];
@@ -295,48 +351,14 @@ sweep_groups(const double *pack, const int *contact, const int *body_a, const in
                                    _mm256_sub_pd(FIBRE_FIELD(kRhs + i), u[i]));
       x[i] = _mm256_fmadd_pd(r, FIBRE_FIELD(kScale + i), old[i]);
     }
-    x[0] = _mm256_and_pd(
-        _mm256_and_pd(_mm256_cmp_pd(x[0], zero, _CMP_GT_OQ), _mm256_cmp_pd(x[0], inf, _CMP_LT_OQ)),
-        x[0]);
-    for (int k = 0; k < num_cones(R); ++k) {
-      const int first = kCones[k].first;
-      const bool pair = kCones[k].size == 2;
-      const V radius = _mm256_mul_pd(FIBRE_FIELD(kCoeff + k), x[0]);
-      V tn2 = _mm256_mul_pd(x[first], x[first]);
-      if (pair) tn2 = _mm256_fmadd_pd(x[first + 1], x[first + 1], tn2);
-      // inside: unchanged; outside: shrunk onto the cone; no cone or a non-finite norm: zero
-      const V keep = _mm256_and_pd(_mm256_cmp_pd(radius, zero, _CMP_GT_OQ),
-                                   _mm256_cmp_pd(tn2, inf, _CMP_LT_OQ));
-      const V outside = _mm256_cmp_pd(tn2, _mm256_mul_pd(radius, radius), _CMP_GT_OQ);
-      const V shrink = _mm256_blendv_pd(one, _mm256_div_pd(radius, _mm256_sqrt_pd(tn2)), outside);
-      x[first] = _mm256_and_pd(keep, _mm256_mul_pd(x[first], shrink));
-      if (pair) x[first + 1] = _mm256_and_pd(keep, _mm256_mul_pd(x[first + 1], shrink));
-    }
+    project_lanes<R>(p, x);
     for (int i = 0; i < R; ++i) {
       delta[i] = _mm256_sub_pd(x[i], old[i]);
       change2 = _mm256_fmadd_pd(delta[i], delta[i], change2);
       size2 = _mm256_fmadd_pd(x[i], x[i], size2);
     }
     store_rows<R>(lc, x);
-    // G^T delta (contact_impulse): f = D^T delta_t, m = D^T delta_r; y_a = [f; ra x f + m],
-    // y_b = -[f; rb x f + m]; then w += M^-1 y
-    V f[3], m[3] = {zero, zero, zero};
-    for (int k = 0; k < 3; ++k) {
-      f[k] = _mm256_fmadd_pd(
-          D[3 * k + 2], delta[2],
-          _mm256_fmadd_pd(D[3 * k + 1], delta[1], _mm256_mul_pd(D[3 * k], delta[0])));
-      if constexpr (R == 6)
-        m[k] = _mm256_fmadd_pd(
-            D[3 * k + 2], delta[5],
-            _mm256_fmadd_pd(D[3 * k + 1], delta[4], _mm256_mul_pd(D[3 * k], delta[3])));
-    }
-    V ya[6], yb[6];
-    body_impulse(ra, f, m, ya);
-    body_impulse(rb, f, m, yb);
-    for (int d = 0; d < 6; ++d) {
-      va[d] = _mm256_fmadd_pd(FIBRE_FIELD(kMassA + d), ya[d], va[d]);
-      vb[d] = _mm256_fnmadd_pd(FIBRE_FIELD(kMassB + d), yb[d], vb[d]);
-    }
+    add_change<R>(p, D, ra, rb, delta, va, vb);
     store_lanes6(wa, va);
     store_lanes6(wb, vb);
 #undef FIBRE_FIELD

@@ -21,7 +21,25 @@ struct Settings {
   int export_every = 0; // write the step's system every N steps (0: never)
   std::string export_prefix;
   int check_every = 0; // solve the step again converged every N steps (0: never)
+  // For the log: typed tuning keywords that have no effect under these settings, and
+  // deprecated ones.
+  std::vector<std::string> notes;
 };
+
+// The two tiers of keywords: what a DEM deck sets, and the solver's tuning.
+enum class KeywordTier { user, tuning };
+
+// One keyword of the table that drives the parser, its error messages and the doc page's
+// Syntax (a test checks that the page lists the same names in the same tiers).
+struct KeywordInfo {
+  std::string name;
+  KeywordTier tier;
+  std::string expected; // the form an error message names: 'tol none|<positive number>'
+  std::string help;     // one line
+};
+
+// Every keyword, the user tier first.
+std::vector<KeywordInfo> keywords();
 
 // What follows "Illegal fix fibre_contact command: " in the front end's error.
 class SettingsError : public std::runtime_error {
