@@ -21,16 +21,19 @@ import sys
 
 DUMP = ("dump trajcmp all custom {every} traj.dump id x y z vx vy vz omegax omegay omegaz\n"
         "dump_modify trajcmp sort id format float %.17g\n")
+# LIGGGHTS's dump_modify takes the whole line's format
+DUMP_LIGGGHTS = ("dump trajcmp all custom {every} traj.dump id x y z vx vy vz omegax omegay omegaz\n"
+                 "dump_modify trajcmp sort id format \"%d" + " %.17g" * 9 + "\"\n")
 
 
-def instrument(text, every):
+def instrument(text, every, dump=DUMP):
     """The deck with the dump before its first run, or None without fix fibre_contact."""
     if not re.search(r"^\s*fix\s+\S+\s+\S+\s+fibre_contact\b", text, re.M):
         return None
     lines = text.splitlines(keepends=True)
     for i, line in enumerate(lines):
         if re.match(r"\s*run\s", line) and not (i > 0 and lines[i - 1].rstrip().endswith("&")):
-            return "".join(lines[:i]) + DUMP.format(every=every) + "".join(lines[i:])
+            return "".join(lines[:i]) + dump.format(every=every) + "".join(lines[i:])
     return None
 
 
@@ -72,11 +75,13 @@ def main():
     p.add_argument("--workdir", default="/tmp/compare_trajectories")
     p.add_argument("--var", nargs=2, action="append", default=[], metavar=("NAME", "VALUE"))
     p.add_argument("--chain", action="store_true", help="run the decks in one folder, in order")
+    p.add_argument("--liggghts", action="store_true", help="LIGGGHTS binaries (its dump_modify)")
     p.add_argument("decks", nargs="+")
     args = p.parse_args()
     worst = 0.0
     for deck in args.decks:
-        text = instrument(open(deck).read(), args.every)
+        text = instrument(open(deck).read(), args.every,
+                          DUMP_LIGGGHTS if args.liggghts else DUMP)
         name = os.path.basename(os.path.dirname(deck)) + "/" + os.path.basename(deck)
         if text is None:
             print(f"{name}: no fix fibre_contact, skipped")

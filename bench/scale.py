@@ -1,0 +1,114 @@
+#!/usr/bin/env python3
+"""The scale benchmark: fix fibre_contact against native LAMMPS on a dense bed that grows
+(bench/scale/in.bed: D fcc cells deep, W across, N = 4 W^2 D spheres settling for tend
+simulated seconds), both twins of one size and process count run back to back.
+
+For each run: wall seconds per simulated second, the largest resident set of any process
+(GNU time), bytes per sphere and per contact above the same method's run of 16 spheres (the
+fix's contacts at the end, walls included; native's pair contacts from compute contact/atom), the fix's sweeps and error estimate of the
+last step, and with --check its last check's velocity error against the converged step. The
+speed ratio is native's wall time over the fix's for the same simulated time.
+
+  python3 bench/scale.py [--lmp build/fix/lmp_fibre] [--N 10000 100000] [--np 1 2]
+                         [--depth 10] [--tend 0.5] [--check] [--workdir W] [--methods ...]
+"""
+
+import argparse
+import os
+import re
+import subprocess
+import sys
+import time
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+sys.path.insert(0, os.path.join(HERE, "..", "tools"))
+from lammps_runs import lmp_env, mpi_prefix, parse_thermo  # noqa: E402
+
+
+def run(lmp, np, method, W, D, tend, check, workdir):
+    """One run; its figures (a dict) or None where it failed."""
+    os.makedirs(workdir, exist_ok=True)
+    log = os.path.join(workdir, "log.%s.W%d.np%d" % (method, W, np))
+    steps = round(tend / 0.002)
+    cmd = mpi_prefix("mpirun", np) + ["/usr/bin/time", "-f", "MAXRSS %M", lmp,
+                                       "-in", os.path.join(HERE, "scale", "in.bed"),
+                                       "-log", log, "-echo", "none", "-var", "W", str(W),
+                                       "-var", "D", str(D), "-var", "method", method,
+                                       "-var", "tend", str(tend),
+                                       "-var", "check", str(steps if check else 0)]
+    t0 = time.time()
+    proc = subprocess.run(cmd, cwd=workdir, stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
+                          env=lmp_env())
+    wall = time.time() - t0
+    out = proc.stdout.decode("utf-8", "replace")
+    if proc.returncode != 0:
+        print("  %s np %d W %d failed (rc %d): %s" % (method, np, W, proc.returncode,
+                                                      out[-400:]))
+        return None
+    text = open(log).read()
+    rows = parse_thermo(text)[-1]
+    last = rows[-1]
+    loop = float(re.search(r"Loop time of (\S+)", text).group(1))
+    rss = max(int(k) for k in re.findall(r"MAXRSS (\d+)", out)) * 1024
+    atoms = int(last["Atoms"])
+    if method == "fibre":
+        contacts = last["f_fc[3]"]
+        extra = {"sweeps": last["f_fc[14]"], "estimate": last["f_fc[16]"],
+                 "check": last["f_fc[19]"] if check else None}
+    else:
+        contacts = last["c_csum"] / 2.0
+        extra = {}
+    zc = re.search(r"^SCALE atoms \S+ zc (\S+)", text, re.M)
+    fig = {"atoms": atoms, "contacts": contacts, "loop": loop, "wall": wall,
+           "per_second": loop / tend, "rss": rss, "zc": float(zc.group(1)) if zc else None}
+    fig.update(extra)
+    return fig
+
+
+def main():
+    p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    p.add_argument("--lmp", default=os.path.join(HERE, "..", "build", "fix", "lmp_fibre"))
+    p.add_argument("--N", type=int, nargs="+", default=[10000, 100000])
+    p.add_argument("--np", type=int, nargs="+", default=[1, 2])
+    p.add_argument("--depth", type=int, default=10)
+    p.add_argument("--tend", type=float, default=0.5)
+    p.add_argument("--check", action="store_true", help="check the last step of the fix")
+    p.add_argument("--methods", nargs="+", default=["fibre", "native"])
+    p.add_argument("--workdir", default="scale-runs")
+    a = p.parse_args()
+    lmp = os.path.abspath(a.lmp)
+    print("| N | np | contacts | fix s / sim s | native s / sim s | native / fix speed | "
+          "RSS fix | RSS native | fix bytes / sphere, / contact | native bytes / sphere, / contact | "
+          "sweeps | estimate | check |")
+    print("|---|---|---|---|---|---|---|---|---|---|---|---|---|")
+    base = {}  # the resident set of a run of 16 spheres, per method and process count
+    for np in a.np:
+        for m in a.methods:
+            small = run(lmp, np, m, 2, 1, 0.01, False, os.path.join(os.path.abspath(a.workdir),
+                                                                  "base"))
+            base[m, np] = small["rss"] if small else 0
+    for n in a.N:
+        W = max(2, round((n / (4.0 * a.depth)) ** 0.5))
+        for np in a.np:
+            figs = {m: run(lmp, np, m, W, a.depth, a.tend, a.check,
+                           os.path.join(os.path.abspath(a.workdir), "W%d" % W)) for m in a.methods}
+            for m, d in figs.items():
+                if d:
+                    d["per_sphere"] = (d["rss"] - base[m, np]) / d["atoms"]
+                    d["per_contact"] = (d["rss"] - base[m, np]) / max(d["contacts"], 1.0)
+            f, nat = figs.get("fibre"), figs.get("native")
+            cell = lambda d, k, fmt, s=1.0: fmt % (s * d[k]) if d and d.get(k) is not None else "-"  # noqa
+            ratio = "%.2fx" % (nat["loop"] / f["loop"]) if f and nat else "-"
+            atoms = (f or nat or {}).get("atoms", 0)
+            print("| %d | %d | %s | %s | %s | %s | %s | %s | %s, %s | %s, %s | %s | %s | %s |" % (
+                atoms, np, cell(f, "contacts", "%.0f"), cell(f, "per_second", "%.1f"),
+                cell(nat, "per_second", "%.1f"), ratio,
+                cell(f, "rss", "%.0f MB", 1e-6), cell(nat, "rss", "%.0f MB", 1e-6),
+                cell(f, "per_sphere", "%.0f"), cell(f, "per_contact", "%.0f"),
+                cell(nat, "per_sphere", "%.0f"), cell(nat, "per_contact", "%.0f"),
+                cell(f, "sweeps", "%.0f"),
+                cell(f, "estimate", "%.2g"), cell(f, "check", "%.2g")), flush=True)
+
+
+if __name__ == "__main__":
+    main()
