@@ -114,3 +114,31 @@ TEST(ContactHistory, OverflowIsCountedNotStored)
                 .norm(),
             1e-14);
 }
+
+// The layout grows with the most contacts one atom stores: an atom with 11 contacts, stored
+// after others with few, and one unpacked with 12, keep every impulse of every atom.
+TEST(ContactHistory, RoomGrowsWithTheMostContactsOnOneAtom)
+{
+  const double h = 1e-3;
+  ContactHistory hist;
+  hist.grow(3);
+  const double before = hist.memory_bytes();
+  std::vector<DetectedContact> found = {contact_on(0, 1.0, Vec3(0, 0, 1)),
+                                        contact_on(2, 2.0, Vec3(1, 0, 1))};
+  for (int k = 0; k < 11; ++k) found.push_back(contact_on(1, 10.0 + k, Vec3(k, 1, 2)));
+  const int n = static_cast<int>(found.size());
+  Vector lambda(6 * n);
+  for (int k = 0; k < 6 * n; ++k) lambda[k] = 0.01 * (k + 1);
+  EXPECT_EQ(hist.store(found, lambda, 6, h, 3), 0);
+  EXPECT_GT(hist.memory_bytes(), before);
+  EXPECT_LT((hist.warm_start(found, 6, h) - lambda).norm(), 1e-14 * lambda.norm());
+  // atom 1's twelve values per slot travel to a new atom 2 whose history had one contact
+  std::vector<double> buf(ContactHistory::kMaxPacked);
+  EXPECT_EQ(hist.pack(1, buf.data()), 1 + 11 * ContactHistory::kSlotSize);
+  ContactHistory other;
+  other.grow(3);
+  EXPECT_EQ(other.unpack(2, buf.data()), 1 + 11 * ContactHistory::kSlotSize);
+  std::vector<DetectedContact> moved(found.begin() + 2, found.end());
+  for (DetectedContact &fc : moved) fc.store = 2;
+  EXPECT_LT((other.warm_start(moved, 6, h) - lambda.tail(6 * 11)).norm(), 1e-14 * lambda.norm());
+}

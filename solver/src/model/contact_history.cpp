@@ -6,13 +6,27 @@ namespace fibre {
 
 void ContactHistory::grow(int nmax)
 {
+  if (nmax > capacity()) relayout(nmax, per_atom_);
+}
+
+// Room for atoms [0, nmax) with `per_atom` slots each, the stored slots kept.
+void ContactHistory::relayout(int nmax, int per_atom)
+{
   const int old = capacity();
-  if (nmax <= old) return;
-  std::unique_ptr<double[]> room(new double[std::size_t(nmax) * kStride]); // not filled
-  for (int i = 0; i < old; ++i)
-    std::copy(slots(i), slots(i) + count_[i] * kSlotSize, room.get() + std::size_t(i) * kStride);
+  const std::size_t stride = std::size_t(per_atom) * kSlotSize;
+  std::unique_ptr<double[]> room(new double[std::size_t(nmax) * stride]); // not filled
+  for (int i = 0; i < std::min(old, nmax); ++i)
+    std::copy(slots(i), slots(i) + count_[i] * kSlotSize, room.get() + std::size_t(i) * stride);
   slots_ = std::move(room);
+  per_atom_ = per_atom;
   count_.resize(nmax, 0);
+}
+
+// Room for n slots on every atom (at most kMaxSlots): the layout grows with the most contacts
+// one atom stores, so that a deck whose atoms store few keeps a small history.
+void ContactHistory::reserve_slots(int n)
+{
+  if (n > per_atom_) relayout(capacity(), std::min(kMaxSlots, std::max(n, per_atom_ + 2)));
 }
 
 void ContactHistory::copy(int from, int to)
@@ -33,6 +47,7 @@ int ContactHistory::unpack(int i, const double *buf, int available, int slot_siz
   slot_size = std::clamp(slot_size, 1, kSlotSize);
   const int n = std::min(
       {kMaxSlots, std::max(0, static_cast<int>(buf[0])), std::max(0, available) / slot_size});
+  reserve_slots(n);
   count_[i] = n;
   double *dst = slots(i);
   for (int k = 0; k < n; ++k, dst += kSlotSize) {
@@ -44,7 +59,8 @@ int ContactHistory::unpack(int i, const double *buf, int available, int slot_siz
 
 double ContactHistory::memory_bytes() const
 {
-  return double(count_.capacity()) * sizeof(int) + double(capacity()) * kStride * sizeof(double);
+  return double(count_.capacity()) * sizeof(int) +
+         double(capacity()) * per_atom_ * kSlotSize * sizeof(double);
 }
 
 const double *ContactHistory::find(int atom, double key) const
@@ -125,6 +141,7 @@ long ContactHistory::store(const std::vector<DetectedContact> &found, const Vect
       ++overflow;
       continue;
     }
+    reserve_slots(count_[s] + 1);
     double *slot = slots(s) + std::size_t(count_[s]++) * kSlotSize;
     slot[0] = fc.key;
     Vec3 tangential = Vec3::Zero(), rolling = Vec3::Zero();

@@ -56,13 +56,20 @@ class ContactHistory {
              int nlocal, const std::vector<std::array<double, kMaxRows>> *springs = nullptr);
 
  private:
-  static constexpr std::size_t kStride = std::size_t(kMaxSlots) * kSlotSize;
   const double *find(int atom, double key) const;
-  double *slots(int atom) const { return slots_.get() + std::size_t(atom) * kStride; }
+  double *slots(int atom) const
+  {
+    return slots_.get() + std::size_t(atom) * std::size_t(per_atom_) * kSlotSize;
+  }
+  void relayout(int nmax, int per_atom);
+  void reserve_slots(int n);
   std::vector<int> count_;
-  // kStride values per atom, of which the first count_ slots are set. Not zero-filled: LAMMPS
-  // grows per-atom arrays by 16384 atoms at a time, and filling that room (29 MB) cost 8% of a
-  // 3 s material run in page faults; untouched room is never read.
+  // per_atom_ slots per atom, of which the first count_ are set: as many as the most that one
+  // atom has stored here (and 2 more), at most kMaxSlots. bench/scale's dense bed stores at
+  // most 7 or 8 on an atom, where a full kMaxSlots made the history 40% of its heap. Not
+  // zero-filled: LAMMPS grows per-atom arrays by 16384 atoms at a time, and filling that room
+  // (29 MB) cost 8% of a 3 s material run in page faults; untouched room is never read.
+  int per_atom_ = 4;
   std::unique_ptr<double[]> slots_;
 };
 
