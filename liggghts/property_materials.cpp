@@ -49,9 +49,41 @@ LAMMPS_NS::FixPropertyGlobal *property(LAMMPS_NS::LAMMPS *lmp, const char *name,
   return nullptr;
 }
 
+// The value of a scalar fix property/global `name` (LIGGGHTS's characteristicVelocity), or 0.
+double scalar_property(LAMMPS_NS::LAMMPS *lmp, const char *name)
+{
+  for (int i = 0; i < lmp->modify->nfix; ++i) {
+    LAMMPS_NS::Fix *fix = lmp->modify->fix[i];
+    if (std::string(fix->style) != "property/global") continue;
+    auto *table = static_cast<LAMMPS_NS::FixPropertyGlobal *>(fix);
+    if (table->check_fix(name, "scalar", 0, 0, "fix fibre_contact", false))
+      return table->compute_scalar();
+  }
+  return 0.0;
+}
+
 bool matches(LAMMPS_NS::PairGran *pair, const char *kind, const char *model)
 {
   return pair && pair->contact_match(kind, model);
+}
+
+// LIGGGHTS's hooke for type pair (i, j): Y_eff and the characteristicVelocity give each
+// contact its k_n and k_t = k_n (fibre::contact_law); the dashpot sqrt(4 m_eff k_n / (1 + (pi /
+// ln e)^2)) is alpha sqrt(m_eff k_n) with alpha = 2 |ln e| / sqrt(ln^2 e + pi^2).
+void set_hooke(LAMMPS_NS::FixPropertyGlobal *young, LAMMPS_NS::FixPropertyGlobal *poisson, int i,
+               int j, double v_char, bool history, fibre::PairCoefficients &p)
+{
+  const double yi = young->compute_vector(i - 1), yj = young->compute_vector(j - 1);
+  const double ni = poisson->compute_vector(i - 1), nj = poisson->compute_vector(j - 1);
+  p.normal = fibre::NormalLaw::hooke;
+  p.hooke_y_eff = 1.0 / ((1.0 - ni * ni) / yi + (1.0 - nj * nj) / yj);
+  p.hooke_velocity = v_char;
+  if (history) p.tangential = fibre::TangentialLaw::linear;
+  const double e = p.restitution;
+  if (e > 0 && e < 1) {
+    const double ln = std::log(e), pi = std::acos(-1.0);
+    p.damping_alpha = 2.0 * std::fabs(ln) / std::sqrt(ln * ln + pi * pi);
+  }
 }
 
 } // namespace
@@ -96,10 +128,12 @@ PairReading read_pair_coefficients(LAMMPS_NS::LAMMPS *lmp)
       out.warnings.push_back(std::string("pair style gran's 'cohesion ") + model +
                              "' is not modelled: the contacts have no cohesion (keep such a "
                              "deck native, or accept cohesionless grains)");
-  if (!hertz)
-    out.notes.push_back("the normal model is not hertz: compliance material has no elastic "
-                        "constants here (LIGGGHTS's hooke stiffness depends on each contact's "
-                        "mass and characteristicVelocity); the rows stay rigid");
+  const bool hooke = matches(pair, "normal", "hooke");
+  const double v_char = hooke ? scalar_property(lmp, "characteristicVelocity") : 0.0;
+  if (!hertz && !(hooke && v_char > 0))
+    out.notes.push_back(
+        "the normal model is neither hertz nor hooke with a characteristicVelocity: "
+        "compliance material has no elastic constants here; the rows stay rigid");
   if (!restitution)
     out.notes.push_back("no coefficientRestitution: contacts are plastic unless the fix's "
                         "restitution keyword is given");
@@ -128,9 +162,11 @@ PairReading read_pair_coefficients(LAMMPS_NS::LAMMPS *lmp)
         const double e = p.restitution;
         if (e > 0 && e <= 1) p.damping_alpha = fibre::liggghts_hertz_damping(e);
       }
+      if (hooke && v_char > 0 && young && poisson)
+        set_hooke(young, poisson, i, j, v_char, history, p);
     }
   out.table = std::move(table);
-  out.material = hertz && young && poisson;
+  out.material = (hertz || (hooke && v_char > 0)) && young && poisson;
   return out;
 }
 

@@ -6,6 +6,9 @@ MPI, restart and bad input, against analytic references.
   sphere's type and the mesh's type (within 1%), with the default (the material's
   compliance) and typed alike; rigid rows (`compliance auto`) keep it below 1e-4 r.
 - The normal dashpot from coefficientRestitution e is LIGGGHTS's hertz one, also at e = 1.
+- LIGGGHTS's hooke with a characteristicVelocity v_c: a sphere at rest on a mesh floor
+  overlaps by m g / k_n, k_n = 16/15 sqrt(r) Y* (15 m v_c^2 / (16 sqrt(r) Y*))^(1/5), as
+  native LIGGGHTS's (both within 1%).
 - An inclined mesh plane: a sphere rolls without slipping at a = 5/7 g sin(theta) when
   tan(theta) < 7/2 mu, and slides at a = g (sin(theta) - mu cos(theta)) above (within 2%); mu
   is the coefficientFriction of the pair (sphere type, mesh type).
@@ -101,6 +104,36 @@ def header(box, mu=0.5, extra_material=(), restitution=0.3, boundary="f f f", pr
 def one_sphere(x, y, z):
     return ["create_atoms 1 single %.17g %.17g %.17g units box" % (x, y, z),
             "set atom 1 diameter %g density %g" % (2 * R, RHO)]
+
+
+def hooke_rest(args, checks):
+    """LIGGGHTS's hooke (characteristicVelocity v_c): a sphere at rest on a mesh floor overlaps
+    by m g / k_n, k_n = 16/15 sqrt(r) Y* (15 m v_c^2 / (16 sqrt(r) Y*))^(1/5) of the sphere
+    against the wall, as native LIGGGHTS's fix wall/gran does (both within 1%)."""
+    v_c = 2.0
+    k_n = 16.0 / 15.0 * math.sqrt(R) * y_eff() * (
+        15.0 * mass() * v_c ** 2 / (16.0 * math.sqrt(R) * y_eff())) ** 0.2
+    expected = mass() * G / k_n
+    overlaps = {}
+    for method in ("fibre", "native"):
+        walls = ("fix fc all fibre_contact wall mesh floor" if method == "fibre" else
+                 "fix n all nve/sphere\nfix w all wall/gran model hooke tangential history mesh "
+                 "n_meshes 1 meshes floor")
+        deck = header("-0.05 0.05 -0.05 0.05 -0.01 0.05") + one_sphere(0, 0, R) + [
+            "fix m5 all property/global characteristicVelocity scalar %g" % v_c,
+            "timestep 0.0001", "fix g all gravity 9.81 vector 0 0 -1",
+            "fix floor all mesh/surface file floor.stl type 2", walls,
+            "variable z equal z[1]", "thermo_style custom step v_z",
+            "thermo_modify format float %.15g", "thermo 1000", "run 20000"]
+        deck = [line.replace("model hertz", "model hooke") for line in deck]
+        run = e2e.run_lmp(args, "\n".join(deck) + "\n", "hooke_rest_" + method)
+        if checks.ran(run):
+            overlaps[method] = R - run.last("z")
+            checks.agree(overlaps[method], expected, 0.01,
+                         "hooke, %s: the overlap at rest is m g / k_n of LIGGGHTS's hooke" % method)
+    if "fibre" in overlaps:
+        checks.check("characteristicVelocity" in open(args.workdir + "/log.hooke_rest_fibre").read(),
+                     "hooke: the log's material names the characteristicVelocity")
 
 
 def rest_on_floor(args, checks):
@@ -318,6 +351,7 @@ def main():
     args = e2e.parse_args()
     checks = e2e.Checks("LIGGGHTS front end: mesh walls, materials, MPI, restart, bad input")
     rest_on_floor(args, checks)
+    hooke_rest(args, checks)
     restitution_dashpot(args, checks)
     incline(args, checks)
     conveyor(args, checks)

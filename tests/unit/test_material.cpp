@@ -708,3 +708,30 @@ TEST(Material, WallCurvatureGivesTheEffectiveRadius)
   c.wall_radius = -0.4; // curved tighter than the sphere (cannot touch there): a plane's
   EXPECT_DOUBLE_EQ(effective_radius(bodies, c), 0.5);
 }
+
+// LIGGGHTS's hooke: a contact's k_n from Y_eff, its m_eff and r_eff and the characteristic
+// velocity (the undamped collision at v_c then overlaps by v_c sqrt(m_eff / k_n)), k_t = k_n;
+// its collision time pi sqrt(m_eff / k_n); a table entry without v_c is returned as it is.
+TEST(Material, LiggghtsHookeStiffnessPerContact)
+{
+  PairCoefficients p;
+  p.normal = NormalLaw::hooke;
+  p.tangential = TangentialLaw::linear;
+  p.hooke_y_eff = 3e6;
+  p.hooke_velocity = 2.0;
+  const double m = 0.0013, r = 0.004;
+  const PairCoefficients q = contact_law(p, m, r);
+  const double expected = 16.0 / 15.0 * std::sqrt(r) * 3e6 *
+                          std::pow(15.0 * m * 4.0 / (16.0 * std::sqrt(r) * 3e6), 0.2);
+  EXPECT_NEAR(q.k_n, expected, 1e-12 * expected);
+  EXPECT_EQ(q.k_t, q.k_n);
+  // Hertz's deepest overlap at v_c, (15 m v^2 / (16 sqrt(r) Y))^(2/5), is the hooke spring's
+  // v sqrt(m / k_n) at that stiffness: the law matches Hertz's at the characteristic velocity
+  const double hertz = std::pow(15.0 * m * 4.0 / (16.0 * std::sqrt(r) * 3e6), 0.4);
+  EXPECT_NEAR(2.0 * std::sqrt(m / q.k_n), hertz, 1e-9 * hertz);
+  EXPECT_NEAR(collision_time(q, r, m, 1.0), std::acos(-1.0) * std::sqrt(m / q.k_n), 1e-15);
+  PairCoefficients plain;
+  plain.normal = NormalLaw::hooke;
+  plain.k_n = 5.0;
+  EXPECT_EQ(contact_law(plain, m, r).k_n, 5.0);
+}

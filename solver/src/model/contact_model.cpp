@@ -196,8 +196,14 @@ void apply_contact_model(const ContactModel &model, const SpookParams &params, d
     const int ta = bodies[c.a].type;
     const int tb = !c.is_wall() ? bodies[c.b].type : c.wall_type > 0 ? c.wall_type : ta;
     const int ntypes = model.materials.ntypes();
-    if (model.per_type() && ta >= 1 && tb >= 1 && ta <= ntypes && tb <= ntypes)
-      apply_pair(model, model.materials.at(ta, tb), params, reff, bodies, last_normal, c);
+    if (model.per_type() && ta >= 1 && tb >= 1 && ta <= ntypes && tb <= ntypes) {
+      const PairCoefficients &pc = model.materials.at(ta, tb);
+      if (pc.hooke_velocity > 0) // LIGGGHTS's hooke: this contact's own stiffnesses
+        apply_pair(model, contact_law(pc, effective_mass(bodies, c), reff), params, reff, bodies,
+                   last_normal, c);
+      else
+        apply_pair(model, pc, params, reff, bodies, last_normal, c);
+    }
     // An impact is a contact that carried no load in the last step; an enduring one does not
     // bounce (without external forces bounce_speed is 0, and Newton's law on every contact of
     // a sheared pack threw its grains out of the cell).

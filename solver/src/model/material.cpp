@@ -276,6 +276,16 @@ bool material_compliance(const PairCoefficients &p, double r_eff, double overlap
   return true;
 }
 
+PairCoefficients contact_law(const PairCoefficients &p, double m_eff, double r_eff)
+{
+  if (!(p.hooke_velocity > 0 && p.hooke_y_eff > 0 && m_eff > 0 && r_eff > 0)) return p;
+  PairCoefficients q = p;
+  const double s = std::sqrt(r_eff), v = p.hooke_velocity, y = p.hooke_y_eff;
+  q.k_n = 16.0 / 15.0 * s * y * std::pow(15.0 * m_eff * v * v / (16.0 * s * y), 0.2);
+  if (q.tangential == TangentialLaw::linear) q.k_t = q.k_n;
+  return q;
+}
+
 double collision_time(const PairCoefficients &p, double r_eff, double m_eff, double v)
 {
   if (p.normal == NormalLaw::none || !(p.k_n > 0) || !(m_eff > 0)) return 0.0;
@@ -293,7 +303,8 @@ PairCollisionTime shortest_collision_time(const MaterialTable &table, double r, 
   PairCollisionTime shortest;
   for (int i = 1; i <= table.ntypes(); ++i)
     for (int j = i; j <= table.ntypes(); ++j) {
-      const double t_c = collision_time(table.at(i, j), 0.5 * r, 0.5 * m, v);
+      const PairCoefficients p = contact_law(table.at(i, j), 0.5 * m, 0.5 * r);
+      const double t_c = collision_time(p, 0.5 * r, 0.5 * m, v);
       if (t_c > 0 && (shortest.t_c == 0 || t_c < shortest.t_c)) shortest = {t_c, i, j};
     }
   return shortest;
@@ -344,6 +355,9 @@ std::vector<std::string> MaterialTable::describe() const
       line += ", restitution " + (p.restitution >= 0 ? g(p.restitution) : std::string("none"));
       if (p.damping_alpha >= 0)
         line += " (the rebound of the damped Hertz or Hooke law, alpha " + g(p.damping_alpha) + ")";
+      if (p.hooke_velocity > 0)
+        line += ", hooke of Y_eff " + g(p.hooke_y_eff) + " at characteristicVelocity " +
+                g(p.hooke_velocity) + " (k_n and k_t per contact)";
       lines.push_back(line);
     }
   return lines;

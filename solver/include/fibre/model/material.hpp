@@ -57,7 +57,17 @@ struct PairCoefficients {
   // element of damping time gamma / k (spring_damping_time).
   double gamma_roll = 0.0;
   double gamma_twist = 0.0;
+  // LIGGGHTS's hooke: the stiffnesses of each contact follow from its effective Young's
+  // modulus and the deck's characteristicVelocity v_c (> 0), k_n = 16/15 sqrt(r_eff) Y_eff (15
+  // m_eff v_c^2 / (16 sqrt(r_eff) Y_eff))^(1/5) and k_t = k_n (contact_law); k_n and k_t are
+  // then 0 in the table.
+  double hooke_y_eff = 0.0;
+  double hooke_velocity = 0.0;
 };
+
+// The coefficients of one contact of reduced mass m_eff and radius r_eff: p itself, or with
+// LIGGGHTS hooke's stiffnesses for that contact.
+PairCoefficients contact_law(const PairCoefficients &p, double m_eff, double r_eff);
 
 // Symmetric table over types 1..ntypes.
 class MaterialTable {
