@@ -119,9 +119,34 @@ def pour_figures(run):
     return {"atoms": blocks[-1][-1]["Atoms"], "ke": mean("KinEng"), "rke": mean("c_1")}
 
 
+# The LIGGGHTS tutorials shortened for the tests: each (old, new) replaces old's first
+# occurrence, in order, in both twins' text (after their DECKS edits)
+SHORTER = {
+    # three of the four insertions: 900 grains falling
+    "insert_stream": (("run\t\t100000", "run 60000"),),
+    # the same growth to the same solid fraction in a fifth of the steps
+    "packing": (("growts equal 50000", "growts equal 10000"),
+                ("relaxts equal 20000", "relaxts equal 4000")),
+    # the first 310 grains, 120 of them carried past the belt's end
+    "conveyor": (("run\t\t\t140000 upto", "run 80000 upto"),),
+    # 200 grains down the chute, to rest
+    "meshGran": (("run\t\t\t10000 upto", "run 4000 upto"),
+                 ("run\t\t\t40000 upto", "run 30000 upto")),
+    # one insertion, the bucket made a wall, moved and turned for a moment
+    "movingMeshGran": (("run\t\t8000 upto", "run 2000 upto"), ("run 14999 upto", "run 5999 upto"),
+                       ("run 15000 upto", "run 6000 upto"), ("run\t\t15000", "run 1000"),
+                       ("run 15000", "run 1000")),
+    # 510 grains on the chute, before any reaches its end
+    "chute_wear": (("run    100000 upto", "run 40000 upto"),),
+}
+
+
 def shortened(name, text):
     """The deck with fewer steps, for the tests (pour: 10000 steps of insertion, 8000 of flow,
-    thermo every 500)."""
+    thermo every 500; the LIGGGHTS tutorials: SHORTER)."""
+    for old, new in SHORTER.get(name, ()):
+        assert old in text, (name, old)
+        text = text.replace(old, new, 1)
     if name != "pour":
         return text
     first = text.index("run\t\t25000")
@@ -142,9 +167,168 @@ def with_figures(text):
     return text + FLATWALL_FIGURES
 
 
+def without_dumps(text):
+    """The deck without its dumps (VTK, mesh STL and mesh VTK files)."""
+    return re.sub(r"(?m)^dump\s.*$", "", text)
+
+
 def bed_deck(text):
     """The cohesion tutorial without its VTK dump, with the bed's figure."""
-    return re.sub(r"(?m)^dump\s.*$", "", text) + BED_FIGURES
+    return without_dumps(text) + BED_FIGURES
+
+
+# The other LIGGGHTS tutorials' figures, printed at the deck's end (both twins; the inserted
+# count is the insertion fix's own log line)
+STREAM_FIGURES = """
+variable na equal count(all)
+variable zc equal xcm(all,z)
+print "FIGURES atoms ${na} zc ${zc}"
+"""
+
+# packing: the solid fraction of the grown grains in the 0.1 x 0.1 x 0.15 box, and the mean
+# number of grains each touches (overlapping neighbours: the compliance's overlaps)
+PACKING_FIGURES = """
+variable na equal count(all)
+compute pk_r all property/atom radius
+variable pk_v atom 4.0/3.0*PI*c_pk_r^3
+compute pk_vsum all reduce sum v_pk_v
+variable phi equal c_pk_vsum/(0.1*0.1*0.15)
+compute pk_cn all contact/atom
+compute pk_cnsum all reduce sum c_pk_cn
+variable cn equal c_pk_cnsum/count(all)
+variable zc equal xcm(all,z)
+thermo_style custom step atoms v_phi v_cn
+run 0
+print "FIGURES atoms ${na} phi ${phi} cn ${cn} zc ${zc}"
+"""
+
+# conveyor: the grains past the belt's end (x < -0.1, dropped into the box) and any outside
+# the box mesh
+CONVEYOR_FIGURES = """
+variable na equal count(all)
+region cv_off block INF -0.1 INF INF INF INF units box
+region cv_box block -0.5 0.5 -0.2 0.2 -0.2 INF units box
+variable off equal count(all,cv_off)
+variable outside equal count(all)-count(all,cv_box)
+variable xc equal xcm(all,x)
+print "FIGURES atoms ${na} off ${off} outside ${outside} xc ${xc}"
+"""
+
+# meshGran: where the grains come to rest at the bottom of the chute (the bed's centre: x,
+# and the height above the floor at z = -1.2) and any outside the mesh's bounding box
+CHUTE_FIGURES = """
+variable na equal count(all)
+region mg_box block -0.008 0.508 -0.058 0.008 -1.209 0.008 units box
+variable outside equal count(all)-count(all,mg_box)
+variable xc equal xcm(all,x)
+variable zc equal xcm(all,z)+1.2
+print "FIGURES atoms ${na} outside ${outside} xc ${xc} zc ${zc}"
+"""
+
+# movingMeshGran: the grains the bucket holds up out of the bed (centres above z = 0; the
+# settled bed's top is at about -0.21), and the grains' centre height
+BUCKET_FIGURES = """
+variable na equal count(all)
+region mm_up block INF INF INF INF 0.0 INF units box
+variable lifted equal count(all,mm_up)
+variable zc equal xcm(all,z)
+print "FIGURES atoms ${na} lifted ${lifted} zc ${zc}"
+"""
+
+
+def bucket_deck(text):
+    """movingMeshGran for both twins, shortened (the whole deck took the fix 17 minutes): the
+    bed settles until step 15000, not 30000, before the bucket becomes a wall, and the bucket
+    turns for 15000 steps, not 25000 (135 degrees: to the top of its turn, its load held up);
+    no dumps, its figures printed."""
+    for old, new in (("run\t\t29999 upto", "run 14999 upto"),
+                     ("run\t\t30000 upto", "run 15000 upto"), ("run\t\t\t25000", "run 15000")):
+        assert old in text
+        text = text.replace(old, new)
+    return without_dumps(text) + BUCKET_FIGURES
+
+
+WEAR_FIGURES = """
+variable na equal count(all)
+print "FIGURES atoms ${na}"
+"""
+
+
+def tutorial_deck(figures_text):
+    """A LIGGGHTS tutorial's edit for both twins: no dumps, its figures printed at the end."""
+    return lambda text: without_dumps(text) + figures_text
+
+
+def inserted(run):
+    """The grains the deck's insertion fixes put in (their log's last running total)."""
+    totals = re.findall(r"a total of (\d+) particle templates", run["log"])
+    return float(totals[-1]) if totals else float("nan")
+
+
+def window_mean(run, block, key, first=0.0, last=1.0):
+    """The mean of a thermo column over the fraction [first, last) of the rows of run block
+    `block` (negative: from the end)."""
+    blocks = run["thermo"]
+    if not -len(blocks) <= block < len(blocks):
+        return float("nan")
+    rows = blocks[block]
+    lo = int(first * len(rows))
+    rows = rows[lo:max(int(last * len(rows)), lo + 1)]
+    return sum(r[key] for r in rows) / len(rows) if rows else float("nan")
+
+
+def stream_figures(run):
+    """insert_stream: grains inserted and kept, and the falling stream's kinetic energy at the
+    end (the box has no walls: grains meet only each other) and centre height."""
+    out = printed_figures(run)
+    out["inserted"] = inserted(run)
+    out["ke"] = window_mean(run, -1, "KinEng", 0.999)
+    return out
+
+
+def packing_figures(run):
+    """packing: grains kept; the grown packing's solid fraction and mean contacts per grain."""
+    out = printed_figures(run)
+    out["inserted"] = inserted(run)
+    return out
+
+
+def conveyor_figures(run):
+    """conveyor: grains inserted and kept, those past the belt's end at the end; the mean
+    kinetic energy of the run (the belt carries the stream off the feed)."""
+    out = printed_figures(run)
+    out["inserted"] = inserted(run)
+    out["ke"] = window_mean(run, -1, "KinEng")
+    return out
+
+
+def meshgran_figures(run):
+    """meshGran: grains inserted and kept, the mean kinetic energy of the flow down the chute
+    (the first half of the run after insertion) and where the grains come to rest."""
+    out = printed_figures(run)
+    out["inserted"] = inserted(run)
+    out["ke"] = window_mean(run, 1, "KinEng", 0.0, 0.5)
+    return out
+
+
+def bucket_figures(run):
+    """movingMeshGran: grains inserted and kept; the kinetic energy while the bucket lifts
+    (the last run) and the grains it holds up at the end."""
+    out = printed_figures(run)
+    out["inserted"] = inserted(run)
+    out["ke"] = window_mean(run, -1, "KinEng")
+    return out
+
+
+def wear_figures(run):
+    """chute_wear: the grains discharged (inserted, less those still in the domain: its
+    boundary is f f f, so grains that leave the chute leave the run), and the mean kinetic
+    energy of the run."""
+    out = printed_figures(run)
+    out["inserted"] = inserted(run)
+    out["ke"] = window_mean(run, -1, "KinEng")
+    out["discharged"] = out["inserted"] - out.get("atoms", float("nan"))
+    return out
 
 
 # name: (host, native path, the native twin's edit, both twins' edit, figures)
@@ -160,6 +344,18 @@ DECKS = {
     "cohesion.noCohesion": ("liggghts", "cohesion/in.noCohesion", same, bed_deck,
                             printed_figures),
     "cohesion.cohesion": ("liggghts", "cohesion/in.cohesion", same, bed_deck, printed_figures),
+    "insert_stream": ("liggghts", "insert_stream/in.insert_stream", same,
+                      tutorial_deck(STREAM_FIGURES), stream_figures),
+    "packing": ("liggghts", "packing/in.packing", same, tutorial_deck(PACKING_FIGURES),
+                packing_figures),
+    "conveyor": ("liggghts", "conveyor/in.conveyor", same, tutorial_deck(CONVEYOR_FIGURES),
+                 conveyor_figures),
+    "meshGran": ("liggghts", "meshGran/in.meshGran", same, tutorial_deck(CHUTE_FIGURES),
+                 meshgran_figures),
+    "movingMeshGran": ("liggghts", "movingMeshGran/in.movingMeshGran", same, bucket_deck,
+                       bucket_figures),
+    "chute_wear": ("liggghts", "chute_wear/in.chute_wear", same, tutorial_deck(WEAR_FIGURES),
+                   wear_figures),
 }
 
 
@@ -172,15 +368,31 @@ def fibre_text(name):
         return DECKS[name][3](f.read())
 
 
-def native_text(name):
+def native_path(name):
     root = EXAMPLES if host(name) == "lammps" else LIGGGHTS_EXAMPLES
-    with open(os.path.join(root, DECKS[name][1])) as f:
+    return os.path.join(root, DECKS[name][1])
+
+
+def native_text(name):
+    with open(native_path(name)) as f:
         return DECKS[name][3](DECKS[name][2](f.read()))
 
 
-def run_deck(lmp, text, workdir, tag, np=1, mpirun="mpirun", variables=None):
-    """Runs one deck text; returns its log, parsed thermo, figures and wall seconds."""
+def inputs(name):
+    """The folder of the deck's original: the files it reads (a tutorial's meshes/) are there."""
+    return os.path.dirname(native_path(name))
+
+
+def run_deck(lmp, text, workdir, tag, np=1, mpirun="mpirun", variables=None, source=None):
+    """Runs one deck text; returns its log, parsed thermo, figures and wall seconds. With
+    source (a folder: inputs(name)), its meshes/ is linked into workdir and post/ made there,
+    as a LIGGGHTS tutorial reads and writes them."""
     os.makedirs(workdir, exist_ok=True)
+    if source:
+        os.makedirs(os.path.join(workdir, "post"), exist_ok=True)
+        meshes, link = os.path.join(source, "meshes"), os.path.join(workdir, "meshes")
+        if os.path.isdir(meshes) and not os.path.lexists(link):
+            os.symlink(meshes, link)
     deck, log = os.path.join(workdir, "in." + tag), os.path.join(workdir, "log." + tag)
     with open(deck, "w") as f:
         f.write(text)
@@ -193,7 +405,7 @@ def run_deck(lmp, text, workdir, tag, np=1, mpirun="mpirun", variables=None):
     proc = subprocess.run(cmd, cwd=workdir, stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
                           env=lmp_env())
     seconds = time.time() - t0
-    text = open(log).read() if os.path.exists(log) else ""
+    text = open(log, errors="replace").read() if os.path.exists(log) else ""
     out = proc.stdout.decode("utf-8", "replace")
     return {"rc": proc.returncode, "log": text, "output": out + text,
             "thermo": parse_thermo(text), "seconds": seconds}
@@ -215,8 +427,9 @@ def main():
     for name in a.decks:
         lmp = os.path.abspath(a.lmp if host(name) == "lammps" else a.liggghts)
         wd = os.path.abspath(os.path.join(a.workdir, name))
-        native = run_deck(lmp, native_text(name), wd, "native", a.np)
-        fibre = run_deck(lmp, fibre_text(name), wd, "fibre", a.np)
+        src = inputs(name) if host(name) == "liggghts" else None
+        native = run_deck(lmp, native_text(name), wd, "native", a.np, source=src)
+        fibre = run_deck(lmp, fibre_text(name), wd, "fibre", a.np, source=src)
         print("%s: native rc %d %.1f s, fix rc %d %.1f s (native/fix speed %.2fx)"
               % (name, native["rc"], native["seconds"], fibre["rc"], fibre["seconds"],
                  native["seconds"] / fibre["seconds"]))
