@@ -5,7 +5,8 @@ simulated seconds), both twins of one size and process count run back to back.
 
 For each run: wall seconds per simulated second, the largest resident set of any process
 (GNU time), bytes per sphere and per contact above the same method's run of 16 spheres (the
-fix's contacts at the end, walls included; native's pair contacts from compute contact/atom), the fix's sweeps and error estimate of the
+fix's contacts at the end, walls included; native's pair contacts from compute contact/atom),
+the fix's sweeps and error estimate of the
 last step, and with --check its last check's velocity error against the converged step. The
 speed ratio is native's wall time over the fix's for the same simulated time.
 
@@ -30,12 +31,11 @@ def run(lmp, np, method, W, D, tend, check, workdir):
     os.makedirs(workdir, exist_ok=True)
     log = os.path.join(workdir, "log.%s.W%d.np%d" % (method, W, np))
     steps = round(tend / 0.002)
-    cmd = mpi_prefix("mpirun", np) + ["/usr/bin/time", "-f", "MAXRSS %M", lmp,
-                                       "-in", os.path.join(HERE, "scale", "in.bed"),
-                                       "-log", log, "-echo", "none", "-var", "W", str(W),
-                                       "-var", "D", str(D), "-var", "method", method,
-                                       "-var", "tend", str(tend),
-                                       "-var", "check", str(steps if check else 0)]
+    cmd = mpi_prefix("mpirun", np) + [
+        "/usr/bin/time", "-f", "MAXRSS %M", lmp, "-in", os.path.join(HERE, "scale", "in.bed"),
+        "-log", log, "-echo", "none", "-var", "W", str(W), "-var", "D", str(D),
+        "-var", "method", method, "-var", "tend", str(tend),
+        "-var", "check", str(steps if check else 0)]
     t0 = time.time()
     proc = subprocess.run(cmd, cwd=workdir, stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
                           env=lmp_env())
@@ -78,14 +78,15 @@ def main():
     a = p.parse_args()
     lmp = os.path.abspath(a.lmp)
     print("| N | np | contacts | fix s / sim s | native s / sim s | native / fix speed | "
-          "RSS fix | RSS native | fix bytes / sphere, / contact | native bytes / sphere, / contact | "
+          "RSS fix | RSS native | fix bytes / sphere, / contact | "
+          "native bytes / sphere, / contact | "
           "sweeps | estimate | check |")
     print("|---|---|---|---|---|---|---|---|---|---|---|---|---|")
     base = {}  # the resident set of a run of 16 spheres, per method and process count
     for np in a.np:
         for m in a.methods:
-            small = run(lmp, np, m, 2, 1, 0.01, False, os.path.join(os.path.abspath(a.workdir),
-                                                                  "base"))
+            small = run(lmp, np, m, 2, 1, 0.01, False,
+                        os.path.join(os.path.abspath(a.workdir), "base"))
             base[m, np] = small["rss"] if small else 0
     for n in a.N:
         W = max(2, round((n / (4.0 * a.depth)) ** 0.5))

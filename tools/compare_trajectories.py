@@ -22,8 +22,8 @@ import sys
 DUMP = ("dump trajcmp all custom {every} traj.dump id x y z vx vy vz omegax omegay omegaz\n"
         "dump_modify trajcmp sort id format float %.17g\n")
 # LIGGGHTS's dump_modify takes the whole line's format
-DUMP_LIGGGHTS = ("dump trajcmp all custom {every} traj.dump id x y z vx vy vz omegax omegay omegaz\n"
-                 "dump_modify trajcmp sort id format \"%d" + " %.17g" * 9 + "\"\n")
+DUMP_LIGGGHTS = ("dump trajcmp all custom {every} traj.dump id x y z vx vy vz omegax omegay "
+                 "omegaz\ndump_modify trajcmp sort id format \"%d" + " %.17g" * 9 + "\"\n")
 
 
 def instrument(text, every, dump=DUMP):

@@ -21,8 +21,8 @@ import fibre_e2e as e2e
 
 LAW = "hertz/material {E} 0.3 0.3 tangential mindlin NULL 1.0 0.5 damping tsuji"
 
-DECK = "units si\n" + "\n".join(e2e.sphere_box("0 {L} 0 {L} 0 {H}", types=2,
-                                                 processors="{procs}")) + """
+BOX = e2e.sphere_box("0 {L} 0 {L} 0 {H}", types=2, processors="{procs}")
+DECK = "units si\n" + "\n".join(BOX) + """
 lattice sc {d}
 region bed block 0 {L} 0 {L} 0 {layers} units box
 create_atoms 1 region bed

@@ -143,8 +143,8 @@ def main():
     # native's do at the same step
     dt = 1e-3 * t_c
     fastest = {}
-    for method, f in (("fibre", fix), ("native", "fix n all nve/sphere\nfix w all wall/gran "
-                                                  "granular " + LAW + " zplane 0 NULL")):
+    native = "fix n all nve/sphere\nfix w all wall/gran granular " + LAW + " zplane 0 NULL"
+    for method, f in (("fibre", fix), ("native", native)):
         name = "short_" + method
         run = e2e.run_lmp(args, COLUMNS.format(procs="1 1 1", atoms=atoms(0.0), dt=dt, fix=f,
                                                every=100, steps=2000, name=name, skin=0.2), name)

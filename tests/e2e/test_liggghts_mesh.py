@@ -132,7 +132,8 @@ def hooke_rest(args, checks):
             checks.agree(overlaps[method], expected, 0.01,
                          "hooke, %s: the overlap at rest is m g / k_n of LIGGGHTS's hooke" % method)
     if "fibre" in overlaps:
-        checks.check("characteristicVelocity" in open(args.workdir + "/log.hooke_rest_fibre").read(),
+        log = open(args.workdir + "/log.hooke_rest_fibre").read()
+        checks.check("characteristicVelocity" in log,
                      "hooke: the log's material names the characteristicVelocity")
 
 

@@ -73,8 +73,8 @@ def main():
         if pour:
             fn, ff, output = pour
             ck.check(ff.get("atoms") == fn.get("atoms") and fn.get("atoms", 0) > 1000,
-                     tag + "every sphere kept", "fix %s, native %s" % (ff.get("atoms"),
-                                                                     fn.get("atoms")))
+                     tag + "every sphere kept",
+                     "fix %s, native %s" % (ff.get("atoms"), fn.get("atoms")))
             ck.check(e2e.rel_err(ff.get("ke", 0), fn.get("ke", 1)) < 0.10,
                      tag + "the flow's mean kinetic energy within 10% of native",
                      "%s vs %s" % (ff.get("ke"), fn.get("ke")))
