@@ -70,20 +70,14 @@ bool matches(LAMMPS_NS::PairGran *pair, const char *kind, const char *model)
 // LIGGGHTS's hooke for type pair (i, j): Y_eff and the characteristicVelocity give each
 // contact its k_n and k_t = k_n (fibre::contact_law); the dashpot sqrt(4 m_eff k_n / (1 + (pi /
 // ln e)^2)) is alpha sqrt(m_eff k_n) with alpha = 2 |ln e| / sqrt(ln^2 e + pi^2).
-void set_hooke(LAMMPS_NS::FixPropertyGlobal *young, LAMMPS_NS::FixPropertyGlobal *poisson, int i,
-               int j, double v_char, bool history, fibre::PairCoefficients &p)
+void set_hooke(double y_eff, double v_char, bool history, fibre::PairCoefficients &p)
 {
-  const double yi = young->compute_vector(i - 1), yj = young->compute_vector(j - 1);
-  const double ni = poisson->compute_vector(i - 1), nj = poisson->compute_vector(j - 1);
   p.normal = fibre::NormalLaw::hooke;
-  p.hooke_y_eff = 1.0 / ((1.0 - ni * ni) / yi + (1.0 - nj * nj) / yj);
+  p.hooke_y_eff = y_eff;
   p.hooke_velocity = v_char;
   if (history) p.tangential = fibre::TangentialLaw::linear;
   const double e = p.restitution;
-  if (e > 0 && e < 1) {
-    const double ln = std::log(e), pi = std::acos(-1.0);
-    p.damping_alpha = 2.0 * std::fabs(ln) / std::sqrt(ln * ln + pi * pi);
-  }
+  if (e > 0 && e <= 1) p.damping_alpha = fibre::liggghts_hooke_damping(e);
 }
 
 } // namespace
@@ -146,10 +140,11 @@ PairReading read_pair_coefficients(LAMMPS_NS::LAMMPS *lmp)
       p.mu = friction->compute_array(i - 1, j - 1);
       if (cdt) p.mu_roll = rolling->compute_array(i - 1, j - 1);
       if (restitution) p.restitution = restitution->compute_array(i - 1, j - 1);
-      if (hertz && young && poisson) {
-        const double yi = young->compute_vector(i - 1), yj = young->compute_vector(j - 1);
-        const double ni = poisson->compute_vector(i - 1), nj = poisson->compute_vector(j - 1);
-        const double y_eff = 1.0 / ((1.0 - ni * ni) / yi + (1.0 - nj * nj) / yj);
+      if (!young || !poisson) continue;
+      const double yi = young->compute_vector(i - 1), yj = young->compute_vector(j - 1);
+      const double ni = poisson->compute_vector(i - 1), nj = poisson->compute_vector(j - 1);
+      const double y_eff = 1.0 / ((1.0 - ni * ni) / yi + (1.0 - nj * nj) / yj);
+      if (hertz) {
         const double g_eff =
             1.0 / (2.0 * (2.0 - ni) * (1.0 + ni) / yi + 2.0 * (2.0 - nj) * (1.0 + nj) / yj);
         p.normal = fibre::NormalLaw::hertz_material;
@@ -162,8 +157,7 @@ PairReading read_pair_coefficients(LAMMPS_NS::LAMMPS *lmp)
         const double e = p.restitution;
         if (e > 0 && e <= 1) p.damping_alpha = fibre::liggghts_hertz_damping(e);
       }
-      if (hooke && v_char > 0 && young && poisson)
-        set_hooke(young, poisson, i, j, v_char, history, p);
+      if (hooke && v_char > 0) set_hooke(y_eff, v_char, history, p);
     }
   out.table = std::move(table);
   out.material = (hertz || (hooke && v_char > 0)) && young && poisson;

@@ -316,6 +316,12 @@ double liggghts_hertz_damping(double e)
   return std::sqrt(5.0) * std::fabs(ln) / std::sqrt(ln * ln + pi * pi);
 }
 
+double liggghts_hooke_damping(double e)
+{
+  const double ln = std::log(e), pi = std::acos(-1.0);
+  return 2.0 * std::fabs(ln) / std::sqrt(ln * ln + pi * pi);
+}
+
 double normal_damper(const PairCoefficients &p, double m_eff, double a, double k)
 {
   if (p.damping_alpha >= 0) return p.damping_alpha * std::sqrt(m_eff * k);

@@ -104,6 +104,9 @@ double restitution_from_tsuji(double alpha);
 // alpha sqrt(m_eff k_n a) of normal_damper: alpha = sqrt(5) |ln e| / sqrt(ln^2 e + pi^2) (its
 // gamma = 2 sqrt(5/6) |beta| sqrt(S m_eff) on S = 2 Y* a, 1.5 the secant). It rebounds at e.
 double liggghts_hertz_damping(double e);
+// LIGGGHTS's hooke dashpot sqrt(4 m_eff k_n / (1 + (pi / ln e)^2)) as alpha sqrt(m_eff k_n):
+// alpha = 2 |ln e| / sqrt(ln^2 e + pi^2), the linear law's exact rebound e.
+double liggghts_hooke_damping(double e);
 
 // The coefficient of restitution that a head-on collision under LAMMPS's damped normal law
 // gives: overlap d, hooke F = k d + alpha sqrt(m k) d', hertz F = k a d + alpha sqrt(m k a) d'
