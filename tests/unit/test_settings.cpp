@@ -381,7 +381,9 @@ TEST(Settings, InertTuningKeywordsAreNoted)
   EXPECT_TRUE(notes("solver cg precond tree linear_tol 1e-6").empty());
   EXPECT_TRUE(noted("sweep_tol 1e-3", "'sweep_tol' has no effect with a tol"));
   EXPECT_TRUE(notes("tol none sweep_tol 1e-3").empty());
-  EXPECT_TRUE(noted("tol none min_sweeps 4", "'min_sweeps' has no effect"));
+  EXPECT_TRUE(notes("solver cg sweep_tol 1e-3").empty()); // the restart after a linear pass
+  EXPECT_TRUE(noted("tol none anderson 0 min_sweeps 4", "'min_sweeps' has no effect"));
+  EXPECT_TRUE(notes("tol none min_sweeps 4").empty()); // Anderson mixes from min_sweeps on
   EXPECT_TRUE(noted("anderson 0 anderson_period 3", "'anderson_period' has no effect"));
   EXPECT_TRUE(noted("sweep_cg yes", "deprecated"));
   EXPECT_TRUE(noted("weight impulse", "'weight' has no effect"));

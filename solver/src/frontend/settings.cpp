@@ -441,16 +441,21 @@ std::vector<Keyword> sweep_keywords()
          st.s.step.sweep_tol = in.positive(i + 1, e);
          return 2;
        },
-       [](const Settings &s) { return s.step.accuracy > 0; },
-       "with a tol (the sweeps stop on its error estimate; tol none stops them on sweep_tol)"},
+       // (after a linear pass it also decides whether the sweeps restart from the warm start)
+       [](const Settings &s) { return s.step.accuracy > 0 && sweeps_only(s); },
+       "with a tol and no linear pass (the sweeps stop on the tol's error estimate)"},
       {{"min_sweeps", T, quoted("min_sweeps", "<non-negative integer>"),
         "the sweeps before a tol may stop them"},
        [](const Reader &in, std::size_t i, const std::string &e, ParseState &st) -> std::size_t {
          st.s.step.min_sweeps = count(in, i + 1, e, 0, 100000);
          return 2;
        },
-       [](const Settings &s) { return !(s.step.accuracy > 0); },
-       "with tol none"},
+       // it also sets where Anderson's mixing and focus_sweeps' period start
+       [](const Settings &s) {
+         const StepOptions &o = s.step;
+         return !(o.accuracy > 0) && o.anderson == 0 && o.focus_sweeps == 0;
+       },
+       "with tol none, without anderson or focus_sweeps"},
       {{"focus_sweeps", T, quoted("focus_sweeps", "<non-negative integer>"),
         "the sweeps over only the contacts the last full one moved"},
        [](const Reader &in, std::size_t i, const std::string &e, ParseState &st) -> std::size_t {
