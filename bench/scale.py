@@ -4,7 +4,8 @@
 simulated seconds), both twins of one size and process count run back to back.
 
 For each run: wall seconds per simulated second, the largest resident set of any process
-(GNU time), bytes per sphere and per contact above the same method's run of 16 spheres (the
+(GNU time), bytes per sphere and per contact above the same method's run of 16 spheres (of the
+largest process, over its share of them; the
 fix's contacts at the end, walls included; native's pair contacts from compute contact/atom),
 the fix's sweeps and error estimate of the
 last step, and with --check its last check's velocity error against the converged step. The
@@ -95,8 +96,9 @@ def main():
                            os.path.join(os.path.abspath(a.workdir), "W%d" % W)) for m in a.methods}
             for m, d in figs.items():
                 if d:
-                    d["per_sphere"] = (d["rss"] - base[m, np]) / d["atoms"]
-                    d["per_contact"] = (d["rss"] - base[m, np]) / max(d["contacts"], 1.0)
+                    # the largest process's: its share of the spheres and contacts
+                    d["per_sphere"] = (d["rss"] - base[m, np]) * np / d["atoms"]
+                    d["per_contact"] = (d["rss"] - base[m, np]) * np / max(d["contacts"], 1.0)
             f, nat = figs.get("fibre"), figs.get("native")
             cell = lambda d, k, fmt, s=1.0: fmt % (s * d[k]) if d and d.get(k) is not None else "-"  # noqa
             ratio = "%.2fx" % (nat["loop"] / f["loop"]) if f and nat else "-"
