@@ -294,6 +294,10 @@ void FixFibreContact::reset_dt()
 
 void FixFibreContact::initial_integrate(int /*vflag*/)
 {
+  // another fix's or command's non-finite values, named before the move spreads them (LAMMPS
+  // would stop on "Non-numeric atom coords" without naming the atom)
+  check_finite("position", atom->x, 3);
+  check_finite("velocity", atom->v, 3);
   double **x = atom->x, **v = atom->v;
   const int *mask = atom->mask;
   for (int i = 0; i < atom->nlocal; ++i)

@@ -2,8 +2,8 @@
 
 Every keyword with a missing or invalid value, an unknown keyword, a wrong atom style, no
 pair style, a pair style without a usable neighbor list, an unknown or moving region, pair
-forces switched back on, a 2d box, and an infinite force (an error naming the atom and the
-step). Each case checks the exit status and that the ERROR
+forces switched back on, a 2d box, and an infinite force or velocity (an error naming the atom
+and the step). Each case checks the exit status and that the ERROR
 line names the problem (the keyword and the expected form). Two runs that complete check
 the log messages: another fix integrating the same atoms (a warning), and the pair style's
 forces switched off.
@@ -135,6 +135,8 @@ CASES = [
     ("comm_tiled", "", "requires comm_style brick", {"pre": "comm_style tiled"}),
     ("infinite_force", "", "non-finite force of atom 1 at step 1",
      {"pre": "fix push all addforce 0 0 1e400"}),
+    ("infinite_velocity", "", "non-finite velocity of atom 1 at step 1",
+     {"pre": "velocity all set 0 0 1e400 units box"}),
     ("restitution", "restitution 1.5", "expected 'restitution <number in [0, 1]>', got '1.5'",
      {}),
     ("bounce_speed", "restitution 0.5 bounce_speed fast",
