@@ -178,12 +178,8 @@ def bed_deck(text):
 
 
 # The other LIGGGHTS tutorials' figures, printed at the deck's end (both twins; the inserted
-# count is the insertion fix's own log line)
-STREAM_FIGURES = """
-variable na equal count(all)
-variable zc equal xcm(all,z)
-print "FIGURES atoms ${na} zc ${zc}"
-"""
+# count is the insertion fix's own log line): the stream's are the cohesion bed's
+STREAM_FIGURES = BED_FIGURES
 
 # packing: the solid fraction of the grown grains in the 0.1 x 0.1 x 0.15 box, and the mean
 # number of grains each touches (overlapping neighbours: the compliance's overlaps)
