@@ -5,6 +5,7 @@
 
 #include "atom.h"
 #include "error.h"
+#include "fibre/model/cohesion.hpp"
 #include "host.h"
 #include "force.h"
 #include "lammps_exchange.h"
@@ -21,6 +22,22 @@ void LammpsDetection::init_walls(const std::vector<fibre::WallSpec> &walls)
   walls_ = walls;
   for (int w = 0; w < static_cast<int>(walls.size()); ++w)
     if (!walls[w].is_primitive()) init_host_wall(w);
+}
+
+void LammpsDetection::set_materials(const fibre::MaterialTable *materials)
+{
+  materials_ = nullptr;
+  if (!materials) return;
+  for (int i = 1; i <= materials->ntypes(); ++i)
+    for (int j = i; j <= materials->ntypes(); ++j)
+      if (materials->at(i, j).cohesion == fibre::CohesionLaw::jkr) materials_ = materials;
+}
+
+double LammpsDetection::hold_reach(int ta, int tb, double r_eff) const
+{
+  if (!materials_ || ta < 1 || tb < 1 || ta > materials_->ntypes() || tb > materials_->ntypes())
+    return 0.0;
+  return fibre::cohesive_reach(materials_->at(ta, tb), r_eff);
 }
 
 // Whether the atoms are stored as at the last call: no neighbour build since (LAMMPS exchanges
@@ -148,10 +165,12 @@ LammpsDetection::contacts(const std::vector<fibre::Body> &bodies, double h, doub
 // is_contact grows with the kick, so the first pass took every other contact already.
 bool LammpsDetection::accept(const fibre::Body &a, const fibre::Body *b, const fibre::Vec3 &n,
                              double gap, double h, double damping, double kick,
-                             double wall_approach) const
+                             double wall_approach, double hold) const
 {
-  if (kick_.empty()) return fibre::is_contact(a, b, n, gap, h, damping, 0.0, wall_approach);
-  return kick > 0.0 && fibre::is_contact(a, b, n, gap, h, damping, kick, wall_approach) &&
+  if (kick_.empty())
+    return gap <= hold || fibre::is_contact(a, b, n, gap, h, damping, 0.0, wall_approach);
+  return !(gap <= hold) && kick > 0.0 &&
+         fibre::is_contact(a, b, n, gap, h, damping, kick, wall_approach) &&
          !fibre::is_contact(a, b, n, gap, h, damping, 0.0, wall_approach);
 }
 
@@ -185,8 +204,10 @@ void LammpsDetection::pair_contacts(const std::vector<fibre::Body> &bodies, doub
       const double dx = x[i][0] - x[j][0], dy = x[i][1] - x[j][1], dz = x[i][2] - x[j][2];
       const double rsq = dx * dx + dy * dy + dz * dz;
       const double radsum = radius[i] + radius[j];
-      if (rsq >= (radsum + reach) * (radsum + reach)) continue;
-
+      const double hold =
+          materials_ ? hold_reach(atom->type[i], atom->type[j], radius[i] * radius[j] / radsum)
+                     : 0.0;
+      if (rsq >= (radsum + reach + hold) * (radsum + reach + hold)) continue;
       // the atom with the smaller tag stores the warm start if it is owned here
       const int low = tag[i] < tag[j] ? i : j, high = low == i ? j : i;
       const int store = low < nlocal ? low : high;
@@ -198,13 +219,15 @@ void LammpsDetection::pair_contacts(const std::vector<fibre::Body> &bodies, doub
         const int a = tag[i] < tag[j] ? bi : bj, b = a == bi ? bj : bi;
         // beyond the reach of is_contact (with a margin for round-off): no contact
         const double far =
-            (1.0 + 1e-9) * fibre::pair_reach(radius[i], radius[j], speed_[a], speed_[b], h, damping,
-                                             kick(a) + kick(b));
+            (1.0 + 1e-9) * std::max(fibre::pair_reach(radius[i], radius[j], speed_[a], speed_[b], h,
+                                                      damping, kick(a) + kick(b)),
+                                    radsum + hold);
         if (rsq >= far * far) continue;
         fibre::Vec3 normal;
         double gap = 0.0;
         fibre::sphere_sphere_gap(bodies[a], bodies[b], normal, gap);
-        if (!accept(bodies[a], &bodies[b], normal, gap, h, damping, kick(a) + kick(b))) continue;
+        if (!accept(bodies[a], &bodies[b], normal, gap, h, damping, kick(a) + kick(b), 0.0, hold))
+          continue;
         // built only here: most listed pairs are no contact, and a Contact is hundreds of bytes
         fibre::DetectedContact &fc = found.emplace_back();
         fc.contact = fibre::sphere_sphere_contact(bodies, a, b, normal, gap);
@@ -227,7 +250,7 @@ void LammpsDetection::pair_contacts(const std::vector<fibre::Body> &bodies, doub
         fc.contact.wall_v = vo + wo.cross(fc.contact.point - xo);
         fc.contact.wall_omega = wo;
         if (!accept(bodies[atom_body_[g]], nullptr, n, fc.contact.gap, h, damping,
-                    kick(atom_body_[g]), n.dot(fc.contact.wall_v)))
+                    kick(atom_body_[g]), n.dot(fc.contact.wall_v), hold))
           continue;
         fc.tag_a = tag[g];
         fc.partner = static_cast<double>(tag[o]);
@@ -244,8 +267,11 @@ void LammpsDetection::add_wall_contact(const std::vector<fibre::Body> &bodies, i
                                        double wall_radius, double h, double damping,
                                        std::vector<fibre::DetectedContact> &found) const
 {
+  const int type = bodies[body].type, wall_type = walls_[wall].type;
+  const double hold =
+      materials_ ? hold_reach(type, wall_type > 0 ? wall_type : type, bodies[body].radius) : 0.0;
   if (!accept(bodies[body], nullptr, n, distance - bodies[body].radius, h, damping, kick(body),
-              n.dot(wall_v)))
+              n.dot(wall_v), hold))
     return;
   fibre::DetectedContact fc;
   fc.contact = fibre::sphere_wall_contact(bodies, body, n, distance);

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "fibre/geometry/detection.hpp"
+#include "fibre/model/material.hpp"
 #include "pointers.h"
 
 namespace fibre_lmp {
@@ -24,6 +25,8 @@ class LammpsDetection : protected LAMMPS_NS::Pointers {
 
   // Resolves the host's walls (region or mesh IDs); call from init().
   void init_walls(const std::vector<fibre::WallSpec> &walls);
+  // The pair style's materials (nullptr: none), for a JKR contact's reach beyond touching.
+  void set_materials(const fibre::MaterialTable *materials);
   // At a run's setup: moving regions record their present position, so that the first step's
   // surface velocity is that step's displacement (not the one since the region was defined).
   void start_moving_walls();
@@ -53,9 +56,14 @@ class LammpsDetection : protected LAMMPS_NS::Pointers {
                         std::vector<fibre::DetectedContact> &found) const;
 
   double kick(int body) const { return kick_.empty() ? 0.0 : kick_[body]; }
-  // fibre::is_contact, and in the impact pass only for the candidates the kicks add
+  // fibre::is_contact, and in the impact pass only for the candidates the kicks add; a gap up
+  // to `hold` (a JKR pair's reach, hold_reach) is a contact in the first pass
   bool accept(const fibre::Body &a, const fibre::Body *b, const fibre::Vec3 &n, double gap,
-              double h, double damping, double kick, double wall_approach = 0.0) const;
+              double h, double damping, double kick, double wall_approach = 0.0,
+              double hold = 0.0) const;
+  // How far apart a contact of types ta, tb (a wall's or obstacle's type for tb) and effective
+  // radius r_eff holds once it has touched: its JKR reach, else 0.
+  double hold_reach(int ta, int tb, double r_eff) const;
 
   // The host's walls, one source file per host: regions (LAMMPS) or meshes (LIGGGHTS); the
   // other host's kind is an error at init.
@@ -69,6 +77,7 @@ class LammpsDetection : protected LAMMPS_NS::Pointers {
   int groupbit_;
   LammpsExchange &exchange_;
   std::vector<fibre::WallSpec> walls_;
+  const fibre::MaterialTable *materials_ = nullptr; // set when some type pair is JKR
   double wall_time_ = 0.0;
   std::vector<double> kick_;   // per body: the speed an impact may give it this step
   std::vector<double> speed_;  // per body: its free speed over this step (fibre::free_speed)

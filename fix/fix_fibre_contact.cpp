@@ -264,6 +264,7 @@ void FixFibreContact::init()
       fibre_lmp::wall_material_types(lmp, walls, model.per_type() ? &model.materials : nullptr);
   for (std::size_t k = 0; k < walls.size(); ++k) walls[k].type = types[k];
   detection_->init_walls(walls);
+  detection_->set_materials(model.per_type() ? &model.materials : nullptr);
   if (comm->me == 0) logmesg(lmp, "fix fibre_contact: " + fibre::describe(settings_) + "\n");
 }
 

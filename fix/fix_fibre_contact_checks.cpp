@@ -79,6 +79,7 @@ void FixFibreContact::read_coefficients()
     return;
   }
   model.materials = reading.table;
+  model.wall_cohesion = reading.wall_cohesion;
   if (!model.typed.compliance) model.compliance.material = reading.material;
   if (comm->me != 0) return;
   for (const std::string &text : reading.warnings) warn(error, FLERR, "Fix fibre_contact: " + text);

@@ -88,6 +88,11 @@ void set_granular(const int *model, const double *normal, const double *tangenti
   p.k_twist = model[4] == 1 ? twist[0] : 0.0;
   p.gamma_roll = model[3] == 1 ? roll[1] : 0.0;
   p.gamma_twist = model[4] == 1 ? twist[1] : 0.0;
+  // dmt's and jkr's surface energy gamma
+  if (model[0] == kDmt || model[0] == kJkr) {
+    p.cohesion = model[0] == kJkr ? fibre::CohesionLaw::jkr : fibre::CohesionLaw::dmt;
+    p.cohesion_energy = normal[3];
+  }
   // the rebound LAMMPS's own law gives (dmt and jkr: their Hertz part)
   if (model[1] == kTsuji) {
     p.damping_alpha = normal[1];
@@ -109,7 +114,6 @@ void read_granular(const std::string &bytes, int ntypes, PairReading &out)
 {
   Record rec(bytes);
   fibre::MaterialTable table(ntypes);
-  std::string cohesion; // the type pairs with dmt or jkr
   for (int i = 1; i <= ntypes; ++i)
     for (int j = i; j <= ntypes; ++j) {
       if (!rec.next_int()) continue; // setflag: mixed at init
@@ -128,9 +132,6 @@ void read_granular(const std::string &bytes, int ntypes, PairReading &out)
         return;
       }
       set_granular(model, normal, tangential, roll, twist, table.at(i, j));
-      if (model[0] == kDmt || model[0] == kJkr)
-        cohesion += (cohesion.empty() ? "" : ", ") + std::to_string(i) + " " + std::to_string(j) +
-                    (model[0] == kDmt ? " dmt" : " jkr");
       if (model[1] != kTsuji)
         out.notes.push_back("types " + std::to_string(i) + " " + std::to_string(j) + ": damping " +
                             kDamping[model[1]] +
@@ -155,11 +156,6 @@ void read_granular(const std::string &bytes, int ntypes, PairReading &out)
                       "by implicit Euler; the tangential rows take the normal law's or its "
                       "critical damping, whichever is longer; bounces take e); the tangential "
                       "damping coefficient is not used");
-  if (!cohesion.empty())
-    out.warnings.push_back("the cohesion of pair_coeff's dmt and jkr is not modelled (types " +
-                           cohesion +
-                           "): those contacts take their Hertz law only, without pull-off; keep "
-                           "such a deck native, or accept cohesionless grains");
   out.table = std::move(table);
   out.material = true;
 }
@@ -274,9 +270,10 @@ std::size_t read_granular_model(const std::vector<std::string> &words, std::size
     // fix wall/gran's wall constant (not the pair's 4/3 E / (2 (1 - nu^2)))
     p.normal = fibre::NormalLaw::hertz_material;
     p.k_n = 4.0 / 3.0 * e_mod / (2.0 * (1.0 - nu));
-    if (n == 4)
-      out.warnings.push_back("the wall's " + m + " cohesion (" + fibre::format_g(v[3]) +
-                             ") is not modelled: the wall takes its Hertz law only");
+    if (n == 4) { // the wall's cohesion, its surface energy gamma
+      p.cohesion = m == "jkr" ? fibre::CohesionLaw::jkr : fibre::CohesionLaw::dmt;
+      p.cohesion_energy = v[3];
+    }
     return n + 1;
   }
   if (m == "damping") {

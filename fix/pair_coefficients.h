@@ -31,6 +31,8 @@ struct PairReading {
   // pair granular and LIGGGHTS's material properties, not the gran/* styles, whose kn = 1 is
   // the common neighbour-list-only setting.
   bool material = false;
+  // Whether walls take a type pair's cohesion (LIGGGHTS: no, fix wall/gran names its own models)
+  bool wall_cohesion = true;
 };
 
 PairReading read_pair_coefficients(LAMMPS_NS::LAMMPS *lmp);

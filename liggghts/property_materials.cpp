@@ -9,6 +9,7 @@
 //     (1/Y* = (1 - nu_i^2)/Y_i + (1 - nu_j^2)/Y_j, 1/G* = 2 (2 - nu_i)(1 + nu_i)/Y_i + ...),
 //     the laws LIGGGHTS's hertz and tangential history apply; `compliance material` uses them,
 //     with hertz's dashpots (their rebound is coefficientRestitution).
+//   cohesionEnergyDensity peratomtypepair      -> cohesion sjkr's k_c (with model hertz)
 // Mesh walls have a type of their own (fix mesh/surface ... type T), so a wall contact takes
 // the pair (sphere type, T) as native LIGGGHTS does.
 #include <cmath>
@@ -80,6 +81,46 @@ void set_hooke(double y_eff, double v_char, bool history, fibre::PairCoefficient
   if (e > 0 && e <= 1) p.damping_alpha = fibre::liggghts_hooke_damping(e);
 }
 
+// LIGGGHTS's hertz with tangential history: k_n = 4/3 Y_eff, Mindlin's k_t = 8 G_eff, and its
+// normal dashpot for the pair's restitution.
+void set_hertz(double y_eff, double g_eff, bool history, fibre::PairCoefficients &p)
+{
+  p.normal = fibre::NormalLaw::hertz_material;
+  p.k_n = 4.0 / 3.0 * y_eff;
+  if (history) {
+    p.tangential = fibre::TangentialLaw::mindlin;
+    p.k_t = 8.0 * g_eff;
+  }
+  const double e = p.restitution;
+  if (e > 0 && e <= 1) p.damping_alpha = fibre::liggghts_hertz_damping(e);
+}
+
+// The pair style's cohesion: sjkr's cohesionEnergyDensity table (nullptr without sjkr, or on
+// a failure), and a WARNING for each cohesion model the fix does not carry.
+LAMMPS_NS::FixPropertyGlobal *read_cohesion(LAMMPS_NS::LAMMPS *lmp, LAMMPS_NS::PairGran *pair,
+                                            bool hertz, PairReading &out)
+{
+  for (const char *model : {"sjkr2", "easo/capillary/viscous", "washino/capillary/viscous"})
+    if (matches(pair, "cohesion", model))
+      out.warnings.push_back(std::string("pair style gran's 'cohesion ") + model +
+                             "' is not modelled: the contacts have no cohesion (keep such a "
+                             "deck native, or accept cohesionless grains)");
+  // LIGGGHTS's walls name their own models: the converted walls take the type's without cohesion
+  out.wall_cohesion = false;
+  if (!matches(pair, "cohesion", "sjkr")) return nullptr;
+  auto *table = property(lmp, "cohesionEnergyDensity", "peratomtypepair", out.failure);
+  if (!table && out.failure.empty())
+    out.failure = "cohesion sjkr needs 'fix ID all property/global cohesionEnergyDensity "
+                  "peratomtypepair " +
+                  std::to_string(lmp->atom->ntypes) + " ...'";
+  out.notes.push_back("cohesion sjkr acts between grains; walls take their type's material "
+                      "without it (as fix wall/gran without 'cohesion sjkr')");
+  if (!hertz)
+    out.warnings.push_back("pair style gran's 'cohesion sjkr' is modelled on model hertz only: "
+                           "these contacts have no cohesion");
+  return out.failure.empty() ? table : nullptr;
+}
+
 } // namespace
 
 PairReading read_pair_coefficients(LAMMPS_NS::LAMMPS *lmp)
@@ -117,11 +158,8 @@ PairReading read_pair_coefficients(LAMMPS_NS::LAMMPS *lmp)
                   std::to_string(ntypes) + " ...'";
     return out;
   }
-  for (const char *model : {"sjkr", "sjkr2", "easo/capillary/viscous", "washino/capillary/viscous"})
-    if (matches(pair, "cohesion", model))
-      out.warnings.push_back(std::string("pair style gran's 'cohesion ") + model +
-                             "' is not modelled: the contacts have no cohesion (keep such a "
-                             "deck native, or accept cohesionless grains)");
+  LAMMPS_NS::FixPropertyGlobal *cohesion = read_cohesion(lmp, pair, hertz, out);
+  if (!out.failure.empty()) return out;
   const bool hooke = matches(pair, "normal", "hooke");
   const double v_char = hooke ? scalar_property(lmp, "characteristicVelocity") : 0.0;
   if (!hertz && !(hooke && v_char > 0))
@@ -147,15 +185,11 @@ PairReading read_pair_coefficients(LAMMPS_NS::LAMMPS *lmp)
       if (hertz) {
         const double g_eff =
             1.0 / (2.0 * (2.0 - ni) * (1.0 + ni) / yi + 2.0 * (2.0 - nj) * (1.0 + nj) / yj);
-        p.normal = fibre::NormalLaw::hertz_material;
-        p.k_n = 4.0 / 3.0 * y_eff;
-        if (history) {
-          p.tangential = fibre::TangentialLaw::mindlin;
-          p.k_t = 8.0 * g_eff;
+        set_hertz(y_eff, g_eff, history, p);
+        if (cohesion) { // F = F_H - k_c A (fibre/model/cohesion.hpp)
+          p.cohesion = fibre::CohesionLaw::sjkr;
+          p.cohesion_energy = cohesion->compute_array(i - 1, j - 1);
         }
-        // LIGGGHTS's hertz normal dashpot
-        const double e = p.restitution;
-        if (e > 0 && e <= 1) p.damping_alpha = fibre::liggghts_hertz_damping(e);
       }
       if (hooke && v_char > 0) set_hooke(y_eff, v_char, history, p);
     }

@@ -159,11 +159,6 @@ WARN_CASES = [
     ("short_damping", "damping 0.5", "Fix fibre_contact: damping 0.5 is below 2 steps", {}),
     ("wall_gran_kept", "wall zplane 0 NULL", "fix w (wall/gran) computes wall forces of its own",
      {"post": "fix w all wall/gran hooke 2000 NULL 50 NULL 0.5 0 zplane 0 NULL"}),
-    ("jkr_cohesion", "", "the cohesion of pair_coeff's dmt and jkr is not modelled (types 1 1 "
-     "jkr)", {"pair": "pair_style granular\npair_coeff * * jkr 1000.0 50.0 0.3 10 tangential "
-              "mindlin 800.0 1.0 0.5"}),
-    ("wall_cohesion", "wall granular dmt 1e5 0.3 0.3 5 tangential linear_history 100 1 0.5 "
-     "zplane 0 NULL", "the wall's dmt cohesion (5) is not modelled", {}),
     ("rotation_axis", "wall region cup", "region cup rotates about an axis of length 1.41421",
      {"pre": "variable th equal 0.1*time\nregion cup block -2 2 -2 2 0 5 side in units box "
              "rotate v_th 0 0 0 1 1 0"}),

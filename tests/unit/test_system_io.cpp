@@ -41,7 +41,9 @@ ContactSystem sample_system(int rows = 6)
   contacts[2].implicit_normal = true;                               // since version 8
   contacts[2].gap = -0.01;
   contacts[2].penetration = 0.75 * 0.01; // since version 9
-  for (Contact &c : contacts)            // an obstacle sphere, since version 6
+  contacts[3].pull = 2.5;                // since version 10
+  contacts[3].gap_shift = -1.0 / 3.0;
+  for (Contact &c : contacts) // an obstacle sphere, since version 6
     if (c.is_wall()) {
       c.wall_radius = 0.375;
       break;
@@ -95,7 +97,7 @@ void expect_identical(const ContactSystem &a, const ContactSystem &b)
                 p.damping == q.damping && p.wall_v == q.wall_v && p.wall_omega == q.wall_omega &&
                 p.elastic == q.elastic && p.spring == q.spring && p.wall_radius == q.wall_radius &&
                 p.spring_damping == q.spring_damping && p.implicit_normal == q.implicit_normal &&
-                p.penetration == q.penetration)
+                p.penetration == q.penetration && p.pull == q.pull && p.gap_shift == q.gap_shift)
         << "contact " << c;
   }
   EXPECT_EQ(a.row_mask(), b.row_mask());
@@ -166,7 +168,7 @@ TEST(SystemIo, RoundTripIsExact)
   for (int rows : {6, 3}) {
     const ContactSystem sys = sample_system(rows);
     const std::string text = to_text(sys);
-    EXPECT_EQ(text.rfind("fibre_contact_system 9\n", 0), 0u);
+    EXPECT_EQ(text.rfind("fibre_contact_system 10\n", 0), 0u);
     const ContactSystem back = parse_system(text);
     expect_identical(sys, back);
     EXPECT_EQ(to_text(back), text); // and the writer is deterministic
@@ -214,24 +216,24 @@ std::string older_version(const ContactSystem &sys, int version, int drop_spook,
 TEST(SystemIo, OlderVersionsAndCoefficientFields)
 {
   const ContactSystem sys = sample_system();
-  const ContactSystem v1 = parse_system(older_version(sys, 1, 2, 24));
+  const ContactSystem v1 = parse_system(older_version(sys, 1, 2, 26));
   ASSERT_EQ(v1.num_contacts(), sys.num_contacts());
   EXPECT_EQ(v1.contacts()[1].friction.mu, FrictionParams{}.mu);
   EXPECT_EQ(v1.contacts()[1].friction.mu_roll, FrictionParams{}.mu_roll);
   EXPECT_EQ(v1.contacts()[1].restitution, 0.0);
   EXPECT_EQ(v1.contacts()[0].compliance, sys.contacts()[0].compliance);
   EXPECT_EQ(v1.params().max_recovery, 0.0);
-  const ContactSystem v2 = parse_system(older_version(sys, 2, 1, 21));
+  const ContactSystem v2 = parse_system(older_version(sys, 2, 1, 23));
   EXPECT_EQ(v2.contacts()[1].friction.mu, 0.3);
   EXPECT_EQ(v2.contacts()[1].restitution, 0.0);
   EXPECT_EQ(v2.params().max_recovery, 0.125);
   EXPECT_EQ(v2.params().bounce_speed, 0.0);
-  const ContactSystem v3 = parse_system(older_version(sys, 3, 0, 13));
+  const ContactSystem v3 = parse_system(older_version(sys, 3, 0, 15));
   EXPECT_EQ(v3.contacts()[1].restitution, 0.7);
   EXPECT_FALSE(v3.contacts()[2].any_elastic());
   // version 4 knows the elastic rows 1..5 only: bit 5 (the normal row) is an error there,
   // and without it the normal row reads rigid
-  const std::string v4_text = older_version(sys, 4, 0, 7);
+  const std::string v4_text = older_version(sys, 4, 0, 9);
   expect_error(v4_text, {"contact 2:", "rows 1 to 5, in [0, 31]"});
   const std::size_t mask_at = v4_text.find(" 59 ", v4_text.find("contacts "));
   ASSERT_NE(mask_at, std::string::npos); // contact 2's mask: rows 0, 1, 2, 4, 5
@@ -241,7 +243,7 @@ TEST(SystemIo, OlderVersionsAndCoefficientFields)
   EXPECT_TRUE(v4.contacts()[2].elastic[1]);
   EXPECT_EQ(v3.contacts()[2].spring, (std::array<double, kMaxRows>{}));
   // version 5 has no obstacle radius: every wall reads flat
-  const ContactSystem v5 = parse_system(older_version(sys, 5, 0, 7));
+  const ContactSystem v5 = parse_system(older_version(sys, 5, 0, 9));
   int obstacles = 0;
   for (int c = 0; c < sys.num_contacts(); ++c) {
     obstacles += sys.contacts()[c].wall_radius > 0;
@@ -249,16 +251,21 @@ TEST(SystemIo, OlderVersionsAndCoefficientFields)
   }
   EXPECT_EQ(obstacles, 1);
   // version 6 has no springs' own damping: every row takes the contact's
-  const ContactSystem v6 = parse_system(older_version(sys, 6, 0, 6));
+  const ContactSystem v6 = parse_system(older_version(sys, 6, 0, 8));
   EXPECT_EQ(v6.contacts()[2].spring_damping,
             (std::array<double, kMaxRows>{-1, -1, -1, -1, -1, -1}));
   EXPECT_EQ(v6.contacts()[2].wall_radius, sys.contacts()[2].wall_radius);
+  // version 9 has no cohesion
+  const ContactSystem v9 = parse_system(older_version(sys, 9, 0, 2));
+  EXPECT_EQ(v9.contacts()[3].pull, 0.0);
+  EXPECT_EQ(v9.contacts()[3].gap_shift, 0.0);
+  EXPECT_EQ(v9.contacts()[2].penetration, sys.contacts()[2].penetration);
   // version 8 has no penetrations
-  const ContactSystem v8 = parse_system(older_version(sys, 8, 0, 1));
+  const ContactSystem v8 = parse_system(older_version(sys, 8, 0, 3));
   EXPECT_EQ(v8.contacts()[2].penetration, 0.0);
   EXPECT_EQ(v8.contacts()[2].spring_damping, sys.contacts()[2].spring_damping);
   // a concave wall (a negative radius) is version 7's: version 6 rejects it
-  const std::string v6_text = older_version(sys, 6, 0, 6);
+  const std::string v6_text = older_version(sys, 6, 0, 8);
   const std::size_t convex = v6_text.find(" 0.375\n");
   ASSERT_NE(convex, std::string::npos);
   expect_error(v6_text.substr(0, convex) + " -0.375\n" + v6_text.substr(convex + 7),
@@ -271,7 +278,7 @@ TEST(SystemIo, OlderVersionsAndCoefficientFields)
   std::vector<std::string> fields;
   std::istringstream words(text.substr(begin, end - begin));
   for (std::string w; words >> w;) fields.push_back(w);
-  ASSERT_EQ(fields.size(), 45u);
+  ASSERT_EQ(fields.size(), 47u);
   const auto with = [&](std::size_t index, const std::string &value) {
     std::vector<std::string> f = fields;
     f[index] = value;
@@ -297,6 +304,8 @@ TEST(SystemIo, OlderVersionsAndCoefficientFields)
   EXPECT_EQ(parse_system(with(43, "3.5")).contacts()[0].spring_damping[5], 3.5);
   expect_error(with(44, "-1e-3"), {"contact 0:", "the penetration must be in [0, the overlap]"});
   expect_error(with(44, "10"), {"contact 0:", "the penetration must be in [0, the overlap]"});
+  expect_error(with(45, "-1"), {"contact 0:", "the pull-off force must not be negative"});
+  EXPECT_EQ(parse_system(with(46, "0.25")).contacts()[0].gap_shift, 0.25);
   if (sys.contacts()[0].is_wall()) return;
   expect_error(with(26, "1"), {"contact 0:", "a pair cannot have a wall velocity"});
 }
@@ -344,7 +353,7 @@ TEST(SystemIo, EachMalformedInputGetsItsOwnError)
 
   expect_error("", {"line 1:", "unexpected end of input", "header"});
   expect_error(edit(0, "fibre_contact_sistem 1"), {"line 1:", "not a fibre_contact system"});
-  expect_error(edit(0, "fibre_contact_system 10"), {"unsupported format version 10"});
+  expect_error(edit(0, "fibre_contact_system 11"), {"unsupported format version 11"});
   expect_error(edit(0, "fibre_contact_system one"), {"'one' is not an integer"});
   expect_error(edit(2, "rows 4"), {"rows must be 3 or 6"});
   expect_error(edit(3, "spook 0 2"), {"time step h must be positive"});
@@ -362,7 +371,7 @@ TEST(SystemIo, EachMalformedInputGetsItsOwnError)
     const std::string cut = join(std::vector<std::string>(L.begin(), L.begin() + last)) +
                             L[last].substr(0, L[last].size() / 2);
     expect_error(cut, {line_tag(last), "contact " + std::to_string(sys.num_contacts() - 1) +
-                                           ": expected 45 values"});
+                                           ": expected 47 values"});
     expect_error(text.substr(0, text.size() - 4), {"unexpected end of input", "'end'"});
     std::vector<std::string> early(L.begin(), L.begin() + bodies + 3);
     expect_error(join(early), {line_tag(bodies), "body count 25 is more than the rest"});
@@ -405,7 +414,7 @@ TEST(SystemIo, EachMalformedInputGetsItsOwnError)
   expect_error(edit(contacts + 1, with_token(c0, 2, "2")), {"contact 0 normal is not a unit"});
   expect_error(edit(contacts + 1, with_token(c0, 15, "0")),
                {"contact 0: compliance of row 0 must be positive"});
-  expect_error(edit(contacts + 1, c0 + " 7"), {"contact 0: expected 45 values, found 46"});
+  expect_error(edit(contacts + 1, c0 + " 7"), {"contact 0: expected 47 values, found 48"});
 
   // Anything after the end, and binary junk.
   expect_error(text + "bodies 1 1\n", {"unexpected content after 'end'"});

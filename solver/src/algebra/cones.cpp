@@ -15,6 +15,13 @@ Cones::Cones(const ContactSystem &sys)
     for (int k = 0; k < num_cones(rows_); ++k)
       coeff_[3 * std::size_t(c) + k] = cone_coefficient(f, sys.effective_radius(c), k);
   }
+  const double h = sys.params().h;
+  for (int c = 0; c < sys.num_contacts(); ++c) {
+    const double pull = sys.contacts()[c].pull;
+    if (!(pull > 0)) continue;
+    if (pull_.empty()) pull_.assign(std::size_t(sys.num_contacts()), 0.0);
+    pull_[c] = h * pull;
+  }
 }
 
 std::vector<Vec6> row_scales(const ContactSystem &sys)

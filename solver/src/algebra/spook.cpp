@@ -67,7 +67,8 @@ Vector spook_rhs(const ContactSystem &sys, const Vector *extra_dv)
       if (k.elastic[r] && sys.row_active(row + r))
         b[row + r] += p.spring_term(k.spring[r], ups_r[r]);
     if (!sys.row_active(row)) continue;
-    const double b_spook = b[row] + p.gap_term(k.gap, ups_c, k.elastic[0], k.penetration);
+    const double b_spook =
+        b[row] + p.gap_term(k.gap + k.gap_shift, ups_c, k.elastic[0], k.penetration);
     // Row: G_n v+ + eps lambda_n = G_n (v + h M^-1 f) + b_n, so b_n = 0 is free flight and
     // Newton's law G_n v+ = -e vn (vn = G_n v) is b_n = b_n(no gap) - (Upsilon + e) vn.
     // A contact that bounces keeps its approach speed until the step in which it closes:
@@ -163,7 +164,9 @@ std::vector<std::array<double, kMaxRows>> advance_springs(const ContactSystem &s
     if (k.penetration > 0) // what is left of it at the step's end (row 0: no spring)
       springs[c][0] = std::min(k.penetration, std::max(0.0, -(k.gap + h * (Gv[base] - wall[0]))));
     if (!k.any_elastic()) continue;
-    const double lambda_n = lambda.size() == sys.contact_dofs() ? std::max(lambda[base], 0.0) : 0.0;
+    // the cones' load (a cohesive contact's: lambda_n + 2 h pull, Cones::project_rows)
+    const double lambda_n =
+        lambda.size() == sys.contact_dofs() ? std::max(lambda[base] + 2.0 * h * k.pull, 0.0) : 0.0;
     for (int cone = 0; cone < num_cones(rows); ++cone) {
       const Cone &rows_of = kCones[cone];
       if (!k.elastic[rows_of.first]) continue;

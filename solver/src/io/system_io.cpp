@@ -30,7 +30,9 @@ constexpr int kContactFieldsV6 = kContactFieldsV5 + 1;
 // version 8: the same, with bit 6 of the elastic rows for an implicit normal row
 constexpr int kContactFieldsV8 = kContactFieldsV6 + kMaxRows - 1;
 // version 9: + the normal row's penetration (Contact::penetration)
-constexpr int kContactFields = kContactFieldsV8 + 1;
+constexpr int kContactFieldsV9 = kContactFieldsV8 + 1;
+// version 10: + cohesion's pull-off force and gap shift (Contact::pull, gap_shift)
+constexpr int kContactFields = kContactFieldsV9 + 2;
 // Unit vectors must read back as unit vectors; exported data are far more exact than this.
 constexpr double kUnitTol = 1e-6;
 
@@ -253,8 +255,10 @@ void write_system(std::ostream &out, const ContactSystem &sys)
       s += ' ';
       put_real(s, c.spring_damping[r]);
     }
-    s += ' ';
-    put_real(s, c.penetration);
+    for (double v : {c.penetration, c.pull, c.gap_shift}) {
+      s += ' ';
+      put_real(s, v);
+    }
     s += '\n';
     out << s;
   }
@@ -307,6 +311,7 @@ int contact_fields_of(long long version)
          : version <= 5 ? kContactFieldsV5
          : version == 6 ? kContactFieldsV6
          : version <= 8 ? kContactFieldsV8
+         : version == 9 ? kContactFieldsV9
                         : kContactFields;
 }
 
@@ -453,6 +458,10 @@ void read_contact_coefficients(Reader &in, const Tokens &t, const std::string &w
   k.penetration = in.real(t[kContactFieldsV8], what + " penetration");
   if (!(k.penetration >= 0) || (k.penetration > 0 && !(k.penetration <= -k.gap)))
     in.fail(what + ": the penetration must be in [0, the overlap]");
+  if (version <= 9) return;
+  k.pull = in.real(t[kContactFieldsV9], what + " pull-off force");
+  if (!(k.pull >= 0)) in.fail(what + ": the pull-off force must not be negative");
+  k.gap_shift = in.real(t[kContactFieldsV9 + 1], what + " gap shift");
 }
 
 std::vector<Contact> read_contacts(Reader &in, Tokens &t, long long version, int nb, int rows)

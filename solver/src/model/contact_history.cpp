@@ -108,6 +108,7 @@ void ContactHistory::load_springs(const std::vector<DetectedContact> &found,
     k.spring.fill(0.0);
     k.penetration = 0.0;
     const double *slot = find(found[c].store, found[c].key);
+    k.touched = slot != nullptr;
     if (!slot) continue;
     const Vec3 tangential = into_plane(Vec3(slot[7], slot[8], slot[9]), k.normal);
     const Vec3 rolling = into_plane(Vec3(slot[10], slot[11], slot[12]), k.normal);
@@ -130,9 +131,10 @@ long ContactHistory::store(const std::vector<DetectedContact> &found, const Vect
     const DetectedContact &fc = found[c];
     const Contact &k = fc.contact;
     const double *l = lambda.data() + Eigen::Index(rows) * c;
-    // released: nothing to remember, but a penetration that opens faster than it must
+    // released: nothing to remember, but a penetration that opens faster than it must (a
+    // cohesive contact that pulls has lambda_n < 0)
     const double penetration = springs ? (*springs)[c][0] : 0.0;
-    if (!(l[0] > 0.0) && !(penetration > 0.0)) continue;
+    if (!(l[0] > 0.0 || l[0] < 0.0) && !(penetration > 0.0)) continue;
     const Vec3 force = (l[0] * k.normal + l[1] * k.t1 + l[2] * k.t2) / h;
     Vec3 moment = Vec3::Zero();
     if (rows == 6) moment = (l[3] * k.normal + l[4] * k.t1 + l[5] * k.t2) / h;

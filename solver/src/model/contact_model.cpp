@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include "fibre/model/cohesion.hpp"
+
 namespace fibre {
 
 double cone_coefficient(const FrictionParams &f, double r_eff, int cone)
@@ -66,8 +68,8 @@ void shorten_to_collision(const PairCoefficients &pc, const SpookParams &params,
 // for the step's acceleration; as much where it opens: a bounce's overlap), where it is more than
 // max_recovery removes in a step. A penetration only shrinks with the overlap, whatever the
 // recovery's force; it is gone with it.
-void track_penetration(const PairCoefficients &pc, const SpookParams &params, double reff,
-                       double overlap, double force, double approach, Contact &c)
+void track_penetration(const SpookParams &params, double explained_overlap, double overlap,
+                       double approach, Contact &c)
 {
   if (!(params.max_recovery > 0)) {
     c.penetration = 0.0;
@@ -77,13 +79,64 @@ void track_penetration(const PairCoefficients &pc, const SpookParams &params, do
     c.penetration = std::min(c.penetration, overlap);
     return;
   }
-  const double explained = law_overlap(pc, reff, force) + 2.0 * params.h * std::abs(approach);
+  const double explained = explained_overlap + 2.0 * params.h * std::abs(approach);
   const double excess = overlap - explained;
   c.penetration = excess > params.h * params.max_recovery ? excess : 0.0;
 }
 
+// A cohesive contact (cohesion.hpp): one whose bodies overlap, or a JKR contact that has
+// touched and is within its reach. Its normal row carries tension down to the pull-off force,
+// whatever the compliance; an enduring one does not bounce.
+void apply_cohesion(const PairCoefficients &pc, double reff, Contact &c)
+{
+  if (pc.cohesion == CohesionLaw::none) return;
+  const bool holds = c.gap < 0 || (pc.cohesion == CohesionLaw::jkr && c.touched &&
+                                   c.gap <= cohesive_reach(pc, reff));
+  if (!holds) return;
+  c.pull = pull_off_force(pc, reff);
+  if (c.touched) c.restitution = 0.0;
+}
+
+// compliance material's normal row of a cohesive contact: the Hertz part's compliance at its
+// load (the law's force plus twice the pull-off, LAMMPS's friction load) and the gap shift that
+// makes the row relax to the law's force at the overlap. Returns the law's overlap at the last
+// load, for the penetration.
+double cohesive_row(const PairCoefficients &pc, double reff, double overlap, double last_force,
+                    Contact &c)
+{
+  const std::array<double, kMaxRows> rigid = c.compliance;
+  const double f = cohesive_force(pc, reff, -c.gap);
+  material_compliance(pc, reff, overlap, std::max(f + 2.0 * c.pull, c.pull), rigid, c.compliance,
+                      c.elastic);
+  c.gap_shift = -c.compliance[0] * f - c.gap;
+  return cohesive_overlap(pc, reff, last_force);
+}
+
+// The restitution of an impact (no load in the last step) under compliance material, where
+// it depends on the impact: a viscous dashpot's on its masses, radii and approach speed (the
+// law's; under compliance auto the gran/* styles' kn is no material), and a cohesive law's,
+// where the impact closes within the step, with the adhesion's work taken out (an integration
+// per impact).
+void impact_restitution(const ContactModel &model, const PairCoefficients &pc,
+                        const SpookParams &params, double reff, const std::vector<Body> &bodies,
+                        Contact &c)
+{
+  const double m_eff = effective_mass(bodies, c), approach = normal_approach(bodies, c);
+  if (pc.restitution < 0 && !(c.pull > 0 && c.touched)) {
+    const double reach = bodies[c.a].radius + (c.is_wall() ? 0.0 : bodies[c.b].radius);
+    const double e = viscous_restitution(pc, m_eff, reff, approach, reach);
+    if (e >= 0) c.restitution = e;
+  }
+  if (pc.cohesion != CohesionLaw::none && !c.touched && (!c.is_wall() || model.wall_cohesion) &&
+      approach > params.bounce_speed && c.gap <= params.h * approach) {
+    const double e = cohesive_restitution(pc, m_eff, reff, approach);
+    if (e >= 0) c.restitution = e;
+  }
+}
+
 void apply_pair(const ContactModel &model, const PairCoefficients &pc, const SpookParams &params,
-                double reff, const std::vector<Body> &bodies, double last_normal, Contact &c)
+                double reff, const std::vector<Body> &bodies, double last_normal, double last_raw,
+                Contact &c)
 {
   const double h = params.h;
   const double overlap = std::max(-c.gap, 0.0);
@@ -93,24 +146,25 @@ void apply_pair(const ContactModel &model, const PairCoefficients &pc, const Spo
   if (!typed.mu_roll) c.friction.mu_roll = f.mu_roll;
   if (!typed.mu_twist) c.friction.mu_twist = f.mu_twist;
   if (!typed.restitution && pc.restitution >= 0) c.restitution = pc.restitution;
+  if (!c.is_wall() || model.wall_cohesion) apply_cohesion(pc, reff, c);
   if (!model.compliance.material) return;
-  // a viscous dashpot's rebound depends on the impact: its masses, radii and approach speed
-  // (the law's; under compliance auto the gran/* styles' kn is no material)
-  if (!typed.restitution && pc.restitution < 0 && last_normal == 0) {
-    const double reach = bodies[c.a].radius + (c.is_wall() ? 0.0 : bodies[c.b].radius);
-    const double e =
-        viscous_restitution(pc, effective_mass(bodies, c), reff, normal_approach(bodies, c), reach);
-    if (e >= 0) c.restitution = e;
-  }
+  const bool cohesive = c.pull > 0;
+  if (!model.typed.restitution && last_normal == 0)
+    impact_restitution(model, pc, params, reff, bodies, c);
   const int rows = model.rows;
   const double force = last_normal / h;
-  track_penetration(pc, params, reff, overlap, force, normal_approach(bodies, c), c);
-  const std::array<double, kMaxRows> rigid = c.compliance;
-  // A penetration's row keeps the law's compliance at its overlap (its last force was the
-  // recovery's), so that it leaves no faster than the law's spring would push it: a soft
-  // material's overlap is removed slower than the recovery speed, as native's is.
-  material_compliance(pc, reff, overlap, c.penetration > 0 ? 0.0 : force, rigid, c.compliance,
-                      c.elastic);
+  if (cohesive) {
+    const double explained = cohesive_row(pc, reff, overlap, last_raw / h, c);
+    track_penetration(params, explained, overlap, normal_approach(bodies, c), c);
+  } else {
+    track_penetration(params, law_overlap(pc, reff, force), overlap, normal_approach(bodies, c), c);
+    const std::array<double, kMaxRows> rigid = c.compliance;
+    // A penetration's row keeps the law's compliance at its overlap (its last force was the
+    // recovery's), so that it leaves no faster than the law's spring would push it: a soft
+    // material's overlap is removed slower than the recovery speed, as native's is.
+    material_compliance(pc, reff, overlap, c.penetration > 0 ? 0.0 : force, rigid, c.compliance,
+                        c.elastic);
+  }
   for (int r = rows; r < kMaxRows; ++r) c.elastic[r] = false;
   // A loaded contact's normal row is a Kelvin-Voigt element with the law's own dashpot (damping
   // time gamma_n / k), at least SPOOK's d, below which a contact stiffer than the step rings
@@ -143,7 +197,7 @@ void apply_pair(const ContactModel &model, const PairCoefficients &pc, const Spo
       c.damper_time[r] = tau;
     }
   }
-  if (force == 0) // an impact, unless it approaches too slowly
+  if (force == 0 && !(cohesive && c.touched)) // an impact, unless it approaches too slowly
     shorten_to_collision(pc, params, reff, m_eff, normal_approach(bodies, c), floor, rows, c);
   // normal_relaxation law: where SPOOK would floor the law's dashpot at `damping` steps (a
   // stiff flow's enduring contacts then relaxed over 2 h, many times the law's time:
@@ -184,13 +238,18 @@ void apply_contact_model(const ContactModel &model, const SpookParams &params, d
     c.damping = -1.0;
     c.spring_damping.fill(-1.0);
     c.damper_time.fill(0.0);
+    c.pull = 0.0;
+    c.gap_shift = 0.0;
     // The last normal impulse, none at round-off: a converged substep leaves 1e-16 where a
     // contact's trial impulse is zero, and such a load made the contact an enduring one,
     // without restitution and with the compliance of a vanishing load (0.1 where the rigid
     // row's is 1e-8), so that one impact bounced by Newton's law in the run and by the law's
     // spring in the converged step.
     const Eigen::Index normal = Eigen::Index(model.rows) * Eigen::Index(k);
-    double last_normal = last && last->size() > normal ? std::max((*last)[normal], 0.0) : 0.0;
+    const double last_raw = last && last->size() > normal ? (*last)[normal] : 0.0;
+    double last_normal = std::max(last_raw, 0.0);
+    // a contact that carried a load within the step has touched (the history's, or a substep's)
+    if (last_raw > 0.0 || last_raw < 0.0) c.touched = true;
     const double speed = std::abs(normal_approach(bodies, c)) + params.bounce_speed;
     if (last_normal <= kRoundoffLoad * effective_mass(bodies, c) * speed) last_normal = 0.0;
     const int ta = bodies[c.a].type;
@@ -200,9 +259,9 @@ void apply_contact_model(const ContactModel &model, const SpookParams &params, d
       const PairCoefficients &pc = model.materials.at(ta, tb);
       if (pc.hooke_velocity > 0) // LIGGGHTS's hooke: this contact's own stiffnesses
         apply_pair(model, contact_law(pc, effective_mass(bodies, c), reff), params, reff, bodies,
-                   last_normal, c);
+                   last_normal, last_raw, c);
       else
-        apply_pair(model, pc, params, reff, bodies, last_normal, c);
+        apply_pair(model, pc, params, reff, bodies, last_normal, last_raw, c);
     }
     // An impact is a contact that carried no load in the last step; an enduring one does not
     // bounce (without external forces bounce_speed is 0, and Newton's law on every contact of

@@ -60,8 +60,10 @@ std::string MaterialTable::mix()
       const auto stiff = [&](double x, double y) {
         return material ? (x > 0 && y > 0 ? 2.0 / (1.0 / x + 1.0 / y) : 0.0) : geom(x, y);
       };
-      if (a.normal != b.normal || a.tangential != b.tangential)
-        return "types " + pair + ": different normal or tangential laws cannot mix";
+      if (a.normal != b.normal || a.tangential != b.tangential || a.cohesion != b.cohesion)
+        return "types " + pair + ": different normal, cohesion or tangential laws cannot mix";
+      p.cohesion = a.cohesion;
+      p.cohesion_energy = geom(a.cohesion_energy, b.cohesion_energy);
       p.normal = a.normal;
       p.tangential = a.tangential;
       p.k_n = stiff(a.k_n, b.k_n);
@@ -364,6 +366,12 @@ std::vector<std::string> MaterialTable::describe() const
       if (p.hooke_velocity > 0)
         line += ", hooke of Y_eff " + g(p.hooke_y_eff) + " at characteristicVelocity " +
                 g(p.hooke_velocity) + " (k_n and k_t per contact)";
+      if (p.cohesion != CohesionLaw::none)
+        line += std::string(", cohesion ") +
+                (p.cohesion == CohesionLaw::jkr   ? "jkr"
+                 : p.cohesion == CohesionLaw::dmt ? "dmt"
+                                                  : "sjkr") +
+                " " + g(p.cohesion_energy);
       lines.push_back(line);
     }
   return lines;

@@ -88,7 +88,8 @@ enum : int {
   kMassA = 33, // the bodies' inverse masses (zero for a wall's side and an empty lane)
   kMassB = 39,
   kCoeff = 45, // the cones' coefficients
-  kFields = 48
+  kPull = 48,  // h times the pull-off force (Cones::pull)
+  kFields = 49
 };
 
 } // namespace
@@ -131,6 +132,7 @@ void GroupedSweep::refresh(const ContactSystem &sys, const Cones &cones, const V
 {
   const double *sigma = sys.sigma().data();
   const std::size_t R = std::size_t(rows_);
+  cohesive_ = cones.cohesive();
   for (std::size_t lane = 0; lane < contact_.size(); ++lane) {
     const int c = contact_[lane];
     if (c < 0) continue;
@@ -142,6 +144,7 @@ void GroupedSweep::refresh(const ContactSystem &sys, const Cones &cones, const V
       put(kScale + int(i), inv_scale[c][Eigen::Index(i)]);
     }
     for (int k = 0; k < num_cones(rows_); ++k) put(kCoeff + k, cones.coeff(c, k));
+    put(kPull, cones.pull(c));
   }
 }
 
@@ -248,18 +251,28 @@ FIBRE_AVX2 void frame_rows(const __m256d D[9], __m256d t0, __m256d t1, __m256d t
 }
 
 // lambda_n >= 0 (NaN and infinity to 0), then each cone (Cones::project_rows) of four
-// contacts' rows x, whose packed data starts at p.
-template <int R> FIBRE_AVX2 void project_lanes(const double *p, __m256d x[R])
+// contacts' rows x, whose packed data starts at p. Cohesive (C): lambda_n >= -h pull (NaN to
+// the bound, infinity to 0), and the cones' load lambda_n + 2 h pull.
+template <int R, bool C> FIBRE_AVX2 void project_lanes(const double *p, __m256d x[R])
 {
   using V = __m256d;
   const V zero = _mm256_setzero_pd(), inf = _mm256_set1_pd(INFINITY), one = _mm256_set1_pd(1.0);
-  x[0] = _mm256_and_pd(
-      _mm256_and_pd(_mm256_cmp_pd(x[0], zero, _CMP_GT_OQ), _mm256_cmp_pd(x[0], inf, _CMP_LT_OQ)),
-      x[0]);
+  V load;
+  if constexpr (C) {
+    const V pull = _mm256_loadu_pd(p + kGroupLanes * kPull), lo = _mm256_sub_pd(zero, pull);
+    x[0] = _mm256_blendv_pd(lo, x[0], _mm256_cmp_pd(x[0], lo, _CMP_GT_OQ));
+    x[0] = _mm256_and_pd(_mm256_cmp_pd(x[0], inf, _CMP_LT_OQ), x[0]);
+    load = _mm256_add_pd(x[0], _mm256_add_pd(pull, pull));
+  } else {
+    x[0] = _mm256_and_pd(
+        _mm256_and_pd(_mm256_cmp_pd(x[0], zero, _CMP_GT_OQ), _mm256_cmp_pd(x[0], inf, _CMP_LT_OQ)),
+        x[0]);
+    load = x[0];
+  }
   for (int k = 0; k < num_cones(R); ++k) {
     const int first = kCones[k].first;
     const bool pair = kCones[k].size == 2;
-    const V radius = _mm256_mul_pd(_mm256_loadu_pd(p + kGroupLanes * (kCoeff + k)), x[0]);
+    const V radius = _mm256_mul_pd(_mm256_loadu_pd(p + kGroupLanes * (kCoeff + k)), load);
     V tn2 = _mm256_mul_pd(x[first], x[first]);
     if (pair) tn2 = _mm256_fmadd_pd(x[first + 1], x[first + 1], tn2);
     // inside: unchanged; outside: shrunk onto the cone; no cone or a non-finite norm: zero
@@ -304,7 +317,7 @@ FIBRE_AVX2 void add_change(const double *p, const __m256d D[9], const __m256d ra
 // The sweep over the groups (pgs.cpp's sweep<R>, four contacts a step). An empty lane reads
 // and writes zeros in `spare` (its packed data is zero); a wall's side reads and writes the
 // spare body (its inverse mass is zero).
-template <int R>
+template <int R, bool C>
 __attribute__((target("avx2,fma"))) void
 sweep_groups(const double *pack, const int *contact, const int *body_a, const int *body_b,
              int groups, double *l, double *w, double norms[2])
@@ -351,7 +364,7 @@ sweep_groups(const double *pack, const int *contact, const int *body_a, const in
                                    _mm256_sub_pd(FIBRE_FIELD(kRhs + i), u[i]));
       x[i] = _mm256_fmadd_pd(r, FIBRE_FIELD(kScale + i), old[i]);
     }
-    project_lanes<R>(p, x);
+    project_lanes<R, C>(p, x);
     for (int i = 0; i < R; ++i) {
       delta[i] = _mm256_sub_pd(x[i], old[i]);
       change2 = _mm256_fmadd_pd(delta[i], delta[i], change2);
@@ -377,12 +390,14 @@ sweep_groups(const double *pack, const int *contact, const int *body_a, const in
 void GroupedSweep::sweep(Vector &lambda, Vector &dv, double norms[2])
 {
   const int groups = static_cast<int>(contact_.size()) / kGroupLanes;
+  const auto run = [&](auto kernel) {
+    kernel(pack_.data(), contact_.data(), body_a_.data(), body_b_.data(), groups, lambda.data(),
+           dv.data(), norms);
+  };
   if (rows_ == 6)
-    sweep_groups<6>(pack_.data(), contact_.data(), body_a_.data(), body_b_.data(), groups,
-                    lambda.data(), dv.data(), norms);
+    cohesive_ ? run(sweep_groups<6, true>) : run(sweep_groups<6, false>);
   else
-    sweep_groups<3>(pack_.data(), contact_.data(), body_a_.data(), body_b_.data(), groups,
-                    lambda.data(), dv.data(), norms);
+    cohesive_ ? run(sweep_groups<3, true>) : run(sweep_groups<3, false>);
 }
 
 #else

@@ -43,9 +43,13 @@ class Cones {
  public:
   explicit Cones(const ContactSystem &sys); // coefficients from each contact's friction
   int rows() const { return rows_; }
+  // Whether some contact is cohesive (Contact::pull): its lambda_n may be negative.
+  bool cohesive() const { return !pull_.empty(); }
+  double pull(int c) const { return pull_.empty() ? 0.0 : pull_[c]; }
   double coeff(int c, int k) const { return coeff_[3 * std::size_t(c) + k]; }
   // lambda_n >= 0 and every cone (radius from the projected normal impulse); l points to
-  // contact c's rows. Non-finite values project to 0.
+  // contact c's rows. Non-finite values project to 0. A cohesive contact's bound is
+  // lambda_n >= -h pull and its radii follow lambda_n + 2 h pull.
   void project(double *l, int c) const
   {
     if (rows_ == 6)
@@ -60,18 +64,21 @@ class Cones {
  private:
   int rows_;
   std::vector<double> coeff_;
+  std::vector<double> pull_; // h Contact::pull per contact; empty: no cohesion
 };
 
 // Squared norms, one square root only for a cone outside.
 template <int R> inline void Cones::project_rows(double *l, int c) const
 {
-  l[0] = l[0] > 0 ? l[0] : 0.0; // also NaN -> 0
+  const double pull = pull_.empty() ? 0.0 : pull_[c];
+  l[0] = l[0] > -pull ? l[0] : -pull; // also NaN -> the bound
   if (!std::isfinite(l[0])) l[0] = 0.0;
+  const double load = l[0] + 2.0 * pull;
   const double *coeff = coeff_.data() + 3 * std::size_t(c);
   for (int k = 0; k < num_cones(R); ++k) {
     double *t = l + kCones[k].first;
     const bool pair = kCones[k].size == 2;
-    const double radius = coeff[k] * l[0];
+    const double radius = coeff[k] * load;
     const double tn2 = t[0] * t[0] + (pair ? t[1] * t[1] : 0.0);
     if (!(radius > 0) || !std::isfinite(tn2)) {
       t[0] = 0.0;

@@ -93,6 +93,15 @@ struct Contact {
   // damping = 3/4 + tau / h without the memory Upsilon G v of the approach speed (spook_rhs).
   // It does not ring at any tau, where SPOOK's rings below 2 steps (design section 2).
   bool implicit_normal = false;
+  // Cohesion (model/cohesion.hpp): the largest tension the normal row carries (a force; 0:
+  // none), so that lambda_n >= -h pull and the friction cones' radii follow lambda_n + 2 h pull
+  // (LAMMPS's |F_ne + 2 F_pulloff|); an elastic row's gap shift, so that it relaxes to the
+  // law's force F(d) at its overlap (gap + gap_shift = -eps F(d)); and whether the history held
+  // the contact (it pressed or pulled in the last step): a JKR contact that has touched holds
+  // until its reach.
+  double pull = 0.0;
+  double gap_shift = 0.0;
+  bool touched = false;
   // An elastic row's own SPOOK damping d (steps), or < 0 for the contact's: the pair style's
   // rolling and twisting dampers (a spring and a damper are SPOOK's compliance and damping
   // time). Rows 1..5; row 0 takes the contact's.

@@ -44,11 +44,12 @@ class ContactHistory {
   Vector warm_start(const std::vector<DetectedContact> &found, int rows, double h) const;
   // Contact::spring of every stored contact in this step's frame: the stored tangential and
   // rolling vectors turned into the new tangent plane with their length kept (LAMMPS's rule),
-  // the twisting angle as it is; and Contact::penetration. `contacts` are the found ones, in their
-  // order.
+  // the twisting angle as it is; Contact::penetration, and Contact::touched (stored).
+  // `contacts` are the found ones, in their order.
   void load_springs(const std::vector<DetectedContact> &found,
                     std::vector<Contact> &contacts) const;
-  // Replaces every stored contact of atoms [0, nlocal) by this step's pressing contacts, with
+  // Replaces every stored contact of atoms [0, nlocal) by this step's pressing (cohesive ones:
+  // or pulling) contacts, with
   // their springs at the step's end (advance_springs, rows per contact, row 0 the penetration
   // left; null: none).
   // Returns how many did not fit (more than kMaxSlots on one atom).

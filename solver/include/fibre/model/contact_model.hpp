@@ -79,6 +79,8 @@ struct ContactModel {
   NormalRelaxation normal_relaxation = NormalRelaxation::spook;
   TypedCoefficients typed{};
   MaterialTable materials; // empty: the pair style gave none (or coefficients fix)
+  // Whether wall contacts (walls and obstacles) take their type pair's cohesion.
+  bool wall_cohesion = true;
   bool per_type() const { return coefficients == CoefficientSource::pair && !materials.empty(); }
   // Whether any contact can have a restitution above 0 (the keyword or a type pair's).
   bool may_bounce() const;

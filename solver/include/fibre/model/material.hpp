@@ -27,6 +27,9 @@ enum class TwistLaw { none, sds, marshall };
 enum class NormalLaw { none, hooke, hertz, hertz_material };
 enum class TangentialLaw { none, linear, mindlin };
 enum class ViscousDamping { none, velocity, mass_velocity, viscoelastic };
+// Cohesion (cohesion.hpp): LAMMPS granular's jkr and dmt (surface energy gamma) and LIGGGHTS's
+// sjkr (cohesion energy density k_c), each on the pair's Hertz law.
+enum class CohesionLaw { none, jkr, dmt, sjkr };
 
 struct PairCoefficients {
   bool set = false;
@@ -63,6 +66,9 @@ struct PairCoefficients {
   // then 0 in the table.
   double hooke_y_eff = 0.0;
   double hooke_velocity = 0.0;
+  // The pair style's cohesion: its law and its gamma (jkr, dmt) or k_c (sjkr).
+  CohesionLaw cohesion = CohesionLaw::none;
+  double cohesion_energy = 0.0;
 };
 
 // The coefficients of one contact of reduced mass m_eff and radius r_eff: p itself, or with

@@ -39,8 +39,9 @@ bool grouped_sweeps_available();
 
 // The groups' data for the sweeps of one solve, packed lane by lane (each of a contact's
 // numbers is one vector load): the rows of G, b, Sigma, the inverse row scales, the cones'
-// coefficients and the bodies' inverse masses. Only where grouped_sweeps_available(). With
-// `list`, the sweeps visit those contacts only (a colour phase of pgs.cpp).
+// coefficients and pull-off impulses (cohesion) and the bodies' inverse masses. Only where
+// grouped_sweeps_available(). With `list`, the sweeps visit those contacts only (a colour phase of
+// pgs.cpp).
 class GroupedSweep {
  public:
   GroupedSweep(const ContactSystem &sys, const Cones &cones, const Vector &b,
@@ -58,7 +59,8 @@ class GroupedSweep {
 
  private:
   int rows_;
-  std::vector<double> pack_;                   // kFields x kGroupLanes per group
+  bool cohesive_ = false;    // Cones::cohesive(): the sweeps with the shifted normal bound
+  std::vector<double> pack_; // kFields x kGroupLanes per group
   std::vector<int> contact_, body_a_, body_b_; // per lane; -1: empty lane, wall
   std::vector<int> singles_;
 };
