@@ -95,8 +95,7 @@ Vector assemble_rhs(const ContactSystem &sys)
       if (r > 0 && k.elastic[r] && sys.row_active(row + r))
         rhs[row + r] += p.spring_term(k.spring[r], ups_r);
     }
-    if (sys.row_active(row))
-      rhs[row] += p.gap_term(k.gap + k.gap_shift, ups_c, k.elastic[0], k.penetration);
+    if (sys.row_active(row)) rhs[row] += p.gap_term(k, ups_c);
     if (sys.row_active(row) && k.implicit_normal) rhs[row] -= ups_c * (Gv[row] - wall[0]);
   }
   return rhs;

@@ -67,8 +67,7 @@ Vector spook_rhs(const ContactSystem &sys, const Vector *extra_dv)
       if (k.elastic[r] && sys.row_active(row + r))
         b[row + r] += p.spring_term(k.spring[r], ups_r[r]);
     if (!sys.row_active(row)) continue;
-    const double b_spook =
-        b[row] + p.gap_term(k.gap + k.gap_shift, ups_c, k.elastic[0], k.penetration);
+    const double b_spook = b[row] + p.gap_term(k, ups_c);
     // Row: G_n v+ + eps lambda_n = G_n (v + h M^-1 f) + b_n, so b_n = 0 is free flight and
     // Newton's law G_n v+ = -e vn (vn = G_n v) is b_n = b_n(no gap) - (Upsilon + e) vn.
     // A contact that bounces keeps its approach speed until the step in which it closes:

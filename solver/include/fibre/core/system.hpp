@@ -202,6 +202,11 @@ struct SpookParams {
     return -4.0 / h * ups * (gap + penetration) + bounded(4.0 / h * ups * penetration);
   }
   double gap_term(double gap) const { return gap_term(gap, upsilon()); }
+  // Contact c's: its gap with cohesion's shift, its elastic normal row and penetration.
+  double gap_term(const Contact &c, double ups) const
+  {
+    return gap_term(c.gap + c.gap_shift, ups, c.elastic[0], c.penetration);
+  }
   // The same term of an elastic row's displacement, unbounded (the cone bounds the spring).
   double spring_term(double displacement, double ups) const
   {
