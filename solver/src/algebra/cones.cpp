@@ -10,17 +10,15 @@ namespace fibre {
 Cones::Cones(const ContactSystem &sys)
     : rows_(sys.rows()), coeff_(std::size_t(sys.num_contacts()) * 3, 0.0)
 {
-  for (int c = 0; c < sys.num_contacts(); ++c) {
-    const FrictionParams &f = sys.contacts()[c].friction;
-    for (int k = 0; k < num_cones(rows_); ++k)
-      coeff_[3 * std::size_t(c) + k] = cone_coefficient(f, sys.effective_radius(c), k);
-  }
   const double h = sys.params().h;
   for (int c = 0; c < sys.num_contacts(); ++c) {
-    const double pull = sys.contacts()[c].pull;
-    if (!(pull > 0)) continue;
+    const Contact &k = sys.contacts()[c];
+    for (int cone = 0; cone < num_cones(rows_); ++cone)
+      coeff_[3 * std::size_t(c) + cone] =
+          cone_coefficient(k.friction, sys.effective_radius(c), cone);
+    if (!(k.pull > 0)) continue;
     if (pull_.empty()) pull_.assign(std::size_t(sys.num_contacts()), 0.0);
-    pull_[c] = h * pull;
+    pull_[c] = h * k.pull;
   }
 }
 

@@ -163,9 +163,9 @@ std::vector<std::array<double, kMaxRows>> advance_springs(const ContactSystem &s
     if (k.penetration > 0) // what is left of it at the step's end (row 0: no spring)
       springs[c][0] = std::min(k.penetration, std::max(0.0, -(k.gap + h * (Gv[base] - wall[0]))));
     if (!k.any_elastic()) continue;
-    // the cones' load (a cohesive contact's: lambda_n + 2 h pull, Cones::project_rows)
-    const double lambda_n =
-        lambda.size() == sys.contact_dofs() ? std::max(lambda[base] + 2.0 * h * k.pull, 0.0) : 0.0;
+    const double lambda_n = lambda.size() == sys.contact_dofs()
+                                ? std::max(cone_load(lambda[base], h * k.pull), 0.0)
+                                : 0.0;
     for (int cone = 0; cone < num_cones(rows); ++cone) {
       const Cone &rows_of = kCones[cone];
       if (!k.elastic[rows_of.first]) continue;

@@ -35,6 +35,7 @@ struct Jkr {
   double E, gamma, r;
   double a_break() const { return std::cbrt(9.0 * kPi * gamma * r * r / (4.0 * E)); }
   double overlap(double a) const { return a * a / r - 2.0 * std::sqrt(kPi * gamma * a / E); }
+  double overlap_slope(double a) const { return 2.0 * a / r - std::sqrt(kPi * gamma / (E * a)); }
   double force(double a) const
   {
     return 4.0 * E * a * a * a / (3.0 * r) - 4.0 * std::sqrt(kPi * gamma * E * a * a * a);
@@ -44,7 +45,7 @@ struct Jkr {
     const double ab = a_break();
     if (!(d > overlap(ab))) return ab;
     return right_root([&](double a) { return overlap(a) - d; },
-                      [&](double a) { return 2.0 * a / r - std::sqrt(kPi * gamma / (E * a)); }, ab);
+                      [&](double a) { return overlap_slope(a); }, ab);
   }
   // Newton from a nearby radius (an impact's last), on [a_b, inf)
   double radius_near(double d, double a0) const
@@ -53,8 +54,7 @@ struct Jkr {
     if (!(d > overlap(ab))) return ab;
     double a = std::max(a0, ab);
     for (int k = 0; k < 50; ++k) {
-      const double slope = 2.0 * a / r - std::sqrt(kPi * gamma / (E * a));
-      const double step = (overlap(a) - d) / slope;
+      const double step = (overlap(a) - d) / overlap_slope(a);
       a = std::max(a - step, ab);
       if (!(std::abs(step) > 1e-14 * a)) break;
     }

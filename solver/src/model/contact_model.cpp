@@ -106,8 +106,8 @@ double cohesive_row(const PairCoefficients &pc, double reff, double overlap, dou
 {
   const std::array<double, kMaxRows> rigid = c.compliance;
   const double f = cohesive_force(pc, reff, -c.gap);
-  material_compliance(pc, reff, overlap, std::max(f + 2.0 * c.pull, c.pull), rigid, c.compliance,
-                      c.elastic);
+  material_compliance(pc, reff, overlap, std::max(cone_load(f, c.pull), c.pull), rigid,
+                      c.compliance, c.elastic);
   c.gap_shift = -c.compliance[0] * f - c.gap;
   return cohesive_overlap(pc, reff, last_force);
 }

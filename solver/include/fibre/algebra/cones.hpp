@@ -73,7 +73,7 @@ template <int R> inline void Cones::project_rows(double *l, int c) const
   const double pull = pull_.empty() ? 0.0 : pull_[c];
   l[0] = l[0] > -pull ? l[0] : -pull; // also NaN -> the bound
   if (!std::isfinite(l[0])) l[0] = 0.0;
-  const double load = l[0] + 2.0 * pull;
+  const double load = cone_load(l[0], pull);
   const double *coeff = coeff_.data() + 3 * std::size_t(c);
   for (int k = 0; k < num_cones(R); ++k) {
     double *t = l + kCones[k].first;

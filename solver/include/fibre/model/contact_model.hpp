@@ -92,6 +92,12 @@ double external_speed_per_step(const std::vector<Body> &bodies, int num_owned, d
 
 // Cone radius per unit normal impulse of cone k (0 Coulomb, 1 twisting, 2 rolling).
 double cone_coefficient(const FrictionParams &f, double r_eff, int cone);
+// The normal load the cones' radii follow: lambda_n, and a cohesive contact's lambda_n + 2 pull
+// (pull its pull-off impulse, or force with a force: LAMMPS's |F_ne + 2 F_pulloff|).
+inline double cone_load(double lambda_n, double pull)
+{
+  return lambda_n + 2.0 * pull;
+}
 
 // A last normal impulse at most this times m_eff (|v_n| + bounce_speed) is round-off, no load.
 inline constexpr double kRoundoffLoad = 1e-9;
