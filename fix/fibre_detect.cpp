@@ -6,6 +6,7 @@
 #include "atom.h"
 #include "error.h"
 #include "fibre/model/cohesion.hpp"
+#include "fibre/model/contact_model.hpp"
 #include "host.h"
 #include "force.h"
 #include "lammps_exchange.h"
@@ -122,9 +123,9 @@ std::vector<fibre::Body> LammpsDetection::bodies()
   return out;
 }
 
-std::vector<fibre::DetectedContact>
-LammpsDetection::contacts(const std::vector<fibre::Body> &bodies, double h, double damping,
-                          bool impacts)
+fibre::FoundContacts LammpsDetection::contacts(const std::vector<fibre::Body> &bodies, double h,
+                                               double damping, bool impacts, double recovery,
+                                               bool recovering)
 {
   std::vector<fibre::DetectedContact> found;
   found.reserve(last_found_ + last_found_ / 8 + 16); // about the last step's, without regrowth
@@ -133,32 +134,49 @@ LammpsDetection::contacts(const std::vector<fibre::Body> &bodies, double h, doub
   for (std::size_t k = 0; k < bodies.size(); ++k) speed_[k] = fibre::free_speed(bodies[k], h);
   pair_contacts(bodies, h, damping, found);
   wall_contacts(bodies, h, damping, found);
-  if (impacts) {
-    // An impact changes both bodies' velocities within the step by up to twice the approach
-    // speed: a sphere at rest hit from above would otherwise pass through the floor, whose
-    // contact its own velocity did not find. Summed over processes (a bound of the maximum).
+  // A rigid row's penetration is opened by a displacement of up to h recovery a step
+  // (fibre/step/recovery.hpp), which moves the bodies around it too: every body may move that
+  // far, and the contacts it can then reach are kept (the displacement closes none of them).
+  // Where the last step recovered, or some overlap is deeper than a penetration's start.
+  double deep = recovering ? 1.0 : 0.0;
+  if (recovery > 0 && !recovering) {
+    for (const fibre::DetectedContact &fc : found)
+      if (-fc.contact.gap > fibre::kPenetrationStart * h * recovery) deep = 1.0;
+    exchange_.max(&deep, 1);
+  }
+  if (impacts || deep > 0) {
     const int nbody = static_cast<int>(bodies.size());
     fibre::Vector kick = fibre::Vector::Zero(6 * Eigen::Index(nbody));
-    for (const fibre::DetectedContact &fc : found) {
-      const fibre::Contact &c = fc.contact;
-      const fibre::Body *b = c.is_wall() ? nullptr : &bodies[c.b];
-      const double approach =
-          fibre::free_approach(bodies[c.a], b, c.normal, h) + c.normal.dot(c.wall_v);
-      if (!(approach > 0.0)) continue;
-      kick[6 * c.a] = std::max(kick[6 * c.a], 2.0 * approach);
-      if (!c.is_wall()) kick[6 * c.b] = std::max(kick[6 * c.b], 2.0 * approach);
-    }
-    exchange_.reverse_sum(kick);
-    exchange_.forward(kick);
+    if (impacts) impact_kicks(bodies, h, found, kick);
     kick_.resize(nbody);
-    for (int k = 0; k < nbody; ++k) kick_[k] = kick[6 * k];
+    for (int k = 0; k < nbody; ++k) kick_[k] = kick[6 * k] + (deep > 0 ? recovery : 0.0);
     // the second pass adds what the kicks reach; the first pass's contacts stand
     pair_contacts(bodies, h, damping, found);
     wall_contacts(bodies, h, damping, found);
   }
-  fibre::sort_contacts(found);
   last_found_ = found.size();
-  return found;
+  return fibre::sort_contacts(std::move(found));
+}
+
+// An impact changes both bodies' velocities within the step by up to twice the approach speed:
+// a sphere at rest hit from above would otherwise pass through the floor, whose contact its own
+// velocity did not find. Summed over processes (a bound of the maximum); kick: 6 per body,
+// the first of each set.
+void LammpsDetection::impact_kicks(const std::vector<fibre::Body> &bodies, double h,
+                                   const std::vector<fibre::DetectedContact> &found,
+                                   fibre::Vector &kick) const
+{
+  for (const fibre::DetectedContact &fc : found) {
+    const fibre::Contact &c = fc.contact;
+    const fibre::Body *b = c.is_wall() ? nullptr : &bodies[c.b];
+    const double approach =
+        fibre::free_approach(bodies[c.a], b, c.normal, h) + c.normal.dot(c.wall_v);
+    if (!(approach > 0.0)) continue;
+    kick[6 * c.a] = std::max(kick[6 * c.a], 2.0 * approach);
+    if (!c.is_wall()) kick[6 * c.b] = std::max(kick[6 * c.b], 2.0 * approach);
+  }
+  exchange_.reverse_sum(kick);
+  exchange_.forward(kick);
 }
 
 // In the impact pass (kicks set) a candidate is new only if its kick brings it into reach:

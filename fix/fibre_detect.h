@@ -40,12 +40,18 @@ class LammpsDetection : protected LAMMPS_NS::Pointers {
   // Every contact this process keeps, in the library's order (fibre::sort_contacts).
   // impacts: contacts may bounce (restitution), so a body hit within the step may move faster
   // than its own velocity says; the contacts it can then reach are kept too (collective).
-  std::vector<fibre::DetectedContact> contacts(const std::vector<fibre::Body> &bodies, double h,
-                                               double damping, bool impacts = false);
+  // recovery: the speed at which rigid rows' penetrations are opened (0: none); where the last
+  // step opened some (recovering) or a contact overlaps by more than kPenetrationStart steps of
+  // it, every body's reach grows by a step of it.
+  fibre::FoundContacts contacts(const std::vector<fibre::Body> &bodies, double h, double damping,
+                                bool impacts = false, double recovery = 0.0,
+                                bool recovering = false);
 
  private:
   void pair_contacts(const std::vector<fibre::Body> &bodies, double h, double damping,
                      std::vector<fibre::DetectedContact> &found) const;
+  void impact_kicks(const std::vector<fibre::Body> &bodies, double h,
+                    const std::vector<fibre::DetectedContact> &found, fibre::Vector &kick) const;
   void wall_contacts(const std::vector<fibre::Body> &bodies, double h, double damping,
                      std::vector<fibre::DetectedContact> &found) const;
   // A wall contact of body with the wall's surface velocity at the point and angular velocity.

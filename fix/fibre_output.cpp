@@ -22,13 +22,13 @@ FibreOutput::~FibreOutput()
   memory->destroy(local_array_);
 }
 
-double FibreOutput::count_contacts(const std::vector<fibre::DetectedContact> &found)
+double FibreOutput::count_contacts(const std::vector<fibre::Contact> &contacts)
 {
-  double sums[2] = {double(found.size()), 0.0};
+  double sums[2] = {double(contacts.size()), 0.0};
   double deepest = 0.0;
-  for (const fibre::DetectedContact &fc : found) {
-    if (fc.contact.is_wall()) sums[1] += 1.0;
-    deepest = std::max(deepest, -fc.contact.gap);
+  for (const fibre::Contact &c : contacts) {
+    if (c.is_wall()) sums[1] += 1.0;
+    deepest = std::max(deepest, -c.gap);
   }
   MPI_Allreduce(MPI_IN_PLACE, sums, 2, MPI_DOUBLE, MPI_SUM, world);
   MPI_Allreduce(MPI_IN_PLACE, &deepest, 1, MPI_DOUBLE, MPI_MAX, world);
@@ -97,11 +97,11 @@ void FibreOutput::report_solve(const fibre::StepResult &res)
   stats_[V_NONCONVERGED] = static_cast<double>(nonconverged_total_);
 }
 
-void FibreOutput::fill_local(const std::vector<fibre::DetectedContact> &found,
+void FibreOutput::fill_local(const std::vector<fibre::ContactTag> &tags,
                              const fibre::Vector *lambda, int rows, double **&array_local,
                              int &size_local_rows)
 {
-  const int nc = static_cast<int>(found.size());
+  const int nc = static_cast<int>(tags.size());
   if (nc > maxlocal_) {
     maxlocal_ = std::max(nc, 2 * maxlocal_);
     memory->destroy(local_array_);
@@ -110,12 +110,12 @@ void FibreOutput::fill_local(const std::vector<fibre::DetectedContact> &found,
   array_local = local_array_;
   size_local_rows = nc;
   for (int c = 0; c < nc; ++c) {
-    const fibre::DetectedContact &fc = found[c];
+    const fibre::ContactTag &fc = tags[c];
     double *row = local_array_[c];
     row[0] = static_cast<double>(fc.tag_a);
     row[1] = fc.partner > 0 ? fc.partner : 0.0;
     row[2] = fc.wall + 1;
-    row[3] = fc.contact.gap;
+    row[3] = fc.gap;
     for (int d = 4; d < kLocalColumns; ++d) row[d] = 0.0;
     if (!lambda) continue;
     const double *l = lambda->data() + Eigen::Index(rows) * c;
@@ -130,7 +130,7 @@ void FibreOutput::fill_local(const std::vector<fibre::DetectedContact> &found,
 }
 
 void FibreOutput::export_step(const std::string &prefix, const fibre::ContactSystem &sys,
-                              const std::vector<fibre::DetectedContact> &found,
+                              const std::vector<fibre::ContactTag> &tags,
                               const fibre::Vector *lambda, const fibre::Vector &warm,
                               const std::vector<int> &owners)
 {
@@ -154,7 +154,7 @@ void FibreOutput::export_step(const std::string &prefix, const fibre::ContactSys
                "warm_%d\n",
                rows - 1, rows - 1);
   for (int c = 0; c < sys.num_contacts(); ++c) {
-    const fibre::DetectedContact &fc = found[c];
+    const fibre::ContactTag &fc = tags[c];
     std::fprintf(fp, "%d %lld %lld %d", c, static_cast<long long>(fc.tag_a),
                  static_cast<long long>(fc.partner > 0 ? fc.partner : 0.0), fc.wall + 1);
     const Eigen::Index at = Eigen::Index(rows) * c;

@@ -65,7 +65,7 @@ class FibreOutput : protected LAMMPS_NS::Pointers {
 
   // Contacts, wall contacts and the deepest overlap over all processes; returns the number
   // of contacts.
-  double count_contacts(const std::vector<fibre::DetectedContact> &found);
+  double count_contacts(const std::vector<fibre::Contact> &contacts);
   // The solve's figures (summed or maximised over processes), with a warning at most every
   // 100 steps while solves fail. A step without contacts reports an empty, converged result.
   void report_solve(const fibre::StepResult &res);
@@ -75,14 +75,14 @@ class FibreOutput : protected LAMMPS_NS::Pointers {
   // A check's errors (keyword check), with a warning where its reference did not converge.
   void report_check(const fibre::StepAccuracy &errors, bool reference_converged, int sweeps);
   // One row per contact: tags, wall, gap, |normal|, |friction|, |rolling|, |twisting| impulse.
-  void fill_local(const std::vector<fibre::DetectedContact> &found, const fibre::Vector *lambda,
-                  int rows, double **&array_local, int &size_local_rows);
+  void fill_local(const std::vector<fibre::ContactTag> &tags, const fibre::Vector *lambda, int rows,
+                  double **&array_local, int &size_local_rows);
   // prefix.STEP.RANK.sys (the system) and .lambda (the atoms of every contact, its impulses and
   // the warm start the solve began from): together the whole step, to replay it; and .images
   // (image body, per line) where ghosts are periodic images of this process's bodies (owners:
   // Exchange::local_owners).
   void export_step(const std::string &prefix, const fibre::ContactSystem &sys,
-                   const std::vector<fibre::DetectedContact> &found, const fibre::Vector *lambda,
+                   const std::vector<fibre::ContactTag> &tags, const fibre::Vector *lambda,
                    const fibre::Vector &warm, const std::vector<int> &owners);
 
   void write_restart(FILE *fp) const;

@@ -30,6 +30,7 @@
 #include "fibre/algebra/spook.hpp"
 #include "fibre/core/text.hpp"
 #include "fibre/model/stress.hpp"
+#include "fibre/step/recovery.hpp"
 #include "fibre/step/substeps.hpp"
 #include "fibre/study/nonsmooth_reference.hpp"
 #include "fibre_output.h"
@@ -204,13 +205,13 @@ void FixFibreContact::start_virial(int vflag)
 ------------------------------------------------------------------------- */
 
 void FixFibreContact::tally_wall_loads(const fibre::ContactSystem &sys,
-                                       const std::vector<fibre::DetectedContact> &found,
+                                       const std::vector<fibre::ContactTag> &tags,
                                        const fibre::Vector &lambda)
 {
   const int nwalls = static_cast<int>(settings_.walls.size());
   if (nwalls == 0) return;
-  std::vector<int> wall_of(found.size());
-  for (std::size_t c = 0; c < found.size(); ++c) wall_of[c] = found[c].wall;
+  std::vector<int> wall_of(tags.size());
+  for (std::size_t c = 0; c < tags.size(); ++c) wall_of[c] = tags[c].wall;
   std::vector<fibre::WallLoad> loads;
   fibre::wall_loads(sys, lambda, wall_of, nwalls, loads);
   exchange_->sum(loads.empty() ? nullptr : loads[0].data(), 6 * nwalls);
@@ -404,29 +405,40 @@ void FixFibreContact::update_velocities(const fibre::Vector *dv)
   }
 }
 
+// Rigid rows' penetrations: opened by a displacement that the next step's move takes, not by
+// a velocity (fibre/step/recovery.hpp). Whether there were any.
+bool FixFibreContact::recover_penetrations(const fibre::Substeps &steps)
+{
+  fibre::Vector dx;
+  if (!fibre::recovery_displacement(steps.system, *exchange_, steps.v_plus, dx)) return false;
+  const std::vector<int> &body_atom = exchange_->body_atom();
+  for (int k = 0; k < exchange_->num_owned(); ++k)
+    for (int d = 0; d < 3; ++d) pending_[body_atom[k]][d] += dx[6 * k + d];
+  return true;
+}
+
 /* ----------------------------------------------------------------------
    the SPOOK step: detect, build, solve, apply, report
 ------------------------------------------------------------------------- */
 
 // The contact solve of a step with contacts somewhere: warm start and springs from the
 // history, the substeps (one solve where nothing moves: substep_when moving) and the step's
-// check. substeps and hs come back as solved.
+// check. found's contacts go into the system. substeps and hs come back as solved.
 fibre::Substeps FixFibreContact::solve_contacts(std::vector<fibre::Body> bodies,
-                                                const std::vector<fibre::DetectedContact> &found,
-                                                int &substeps, double &hs)
+                                                fibre::FoundContacts &found, int &substeps,
+                                                double &hs)
 {
   const fibre::ContactModel &model = settings_.model;
-  std::vector<fibre::Contact> contacts;
-  contacts.reserve(found.size());
-  for (const fibre::DetectedContact &fc : found) contacts.push_back(fc.contact);
+  std::vector<fibre::Contact> contacts = std::move(found.contacts);
+  found.contacts.clear();
   fibre::SpookParams params = step_params(bodies, hs);
-  fibre::Vector warm = history_.warm_start(found, model.rows, hs);
-  history_.load_springs(found, contacts);
+  fibre::Vector warm = history_.warm_start(found.tags, contacts, model.rows, hs);
+  history_.load_springs(found.tags, contacts);
   if (substeps > 1 && model.substep_moving_only && !step_moves(bodies, contacts, hs)) {
     substeps = 1;
     hs = dtv_;
     params = step_params(bodies, hs);
-    warm = history_.warm_start(found, model.rows, hs);
+    warm = history_.warm_start(found.tags, contacts, model.rows, hs);
   }
   const bool check = settings_.check_every > 0 && update->ntimestep % settings_.check_every == 0;
   std::vector<fibre::Body> bodies_at_start;
@@ -455,11 +467,10 @@ fibre::Substeps FixFibreContact::solve_contacts(std::vector<fibre::Body> bodies,
 // The step's report: the local array, the solve's figures, the export and the history's
 // overflow.
 void FixFibreContact::report_step(const fibre::Substeps &steps,
-                                  const std::vector<fibre::DetectedContact> &found, bool any,
-                                  bool solved)
+                                  const std::vector<fibre::ContactTag> &tags, bool any, bool solved)
 {
   const fibre::StepResult &res = steps.result;
-  output_->fill_local(found, solved ? &steps.lambda : nullptr, settings_.model.rows, array_local,
+  output_->fill_local(tags, solved ? &steps.lambda : nullptr, settings_.model.rows, array_local,
                       size_local_rows);
   if (steps.done > 1) {
     fibre::StepResult all = steps.totals;
@@ -472,7 +483,7 @@ void FixFibreContact::report_step(const fibre::Substeps &steps,
   }
   output_->report_substeps(any ? steps.done : 0);
   if (settings_.export_every > 0 && update->ntimestep % settings_.export_every == 0)
-    output_->export_step(settings_.export_prefix, steps.system, found, any ? &res.lambda : nullptr,
+    output_->export_step(settings_.export_prefix, steps.system, tags, any ? &res.lambda : nullptr,
                          steps.warm, exchange_->local_owners());
   if (overflow_count_ > 0 && !overflow_warned_ && comm->me == 0) {
     warn(error, FLERR,
@@ -500,23 +511,23 @@ void FixFibreContact::final_integrate()
   // substep moves on at its new speed in the others (without, a stiff pour blew up).
   int substeps = step_substeps();
   double hs = dtv_ / substeps;
-  std::vector<fibre::DetectedContact> found =
-      detection_->contacts(bodies, dtv_, model.damping, model.may_bounce() || substeps > 1);
-  if (first_step_) warn_deep_overlaps(bodies, found, step_params(bodies, hs).max_recovery);
+  const double recovery = step_params(bodies, hs).max_recovery;
+  fibre::FoundContacts found =
+      detection_->contacts(bodies, dtv_, model.damping, model.may_bounce() || substeps > 1,
+                           model.compliance.material ? 0.0 : recovery, recovering_);
+  if (first_step_) warn_deep_overlaps(bodies, found.contacts, recovery);
   warn_skin();
   first_step_ = false;
-  const bool any = output_->count_contacts(found) > 0;
+  const bool any = output_->count_contacts(found.contacts) > 0;
 
   // build and solve (a step without contacts anywhere is free flight: an empty system)
   fibre::Substeps steps;
   if (any) {
     steps = solve_contacts(std::move(bodies), found, substeps, hs);
   } else {
-    std::vector<fibre::Contact> contacts;
-    for (const fibre::DetectedContact &fc : found) contacts.push_back(fc.contact);
     const fibre::SpookParams params = step_params(bodies, hs);
-    steps.system = fibre::ContactSystem(std::move(bodies), std::move(contacts), model.rows, params,
-                                        exchange_->num_owned());
+    steps.system = fibre::ContactSystem(std::move(bodies), std::move(found.contacts), model.rows,
+                                        params, exchange_->num_owned());
   }
   const fibre::ContactSystem &sys = steps.system;
   const fibre::StepResult &res = steps.result;
@@ -528,18 +539,20 @@ void FixFibreContact::final_integrate()
   // the loads and the virial of the step's mean force (sys's step is a substep's)
   const fibre::Vector lambda_mean =
       substepped ? fibre::Vector(steps.lambda / double(steps.done)) : res.lambda;
-  tally_wall_loads(sys, found, lambda_mean);
+  tally_wall_loads(sys, found.tags, lambda_mean);
   if (evflag) // this step's virial is wanted (post_force)
     tally_virial(sys, lambda_mean.size() ? lambda_mean : fibre::Vector::Zero(sys.contact_dofs()));
   // the energy the moving walls put in and the contacts take out
+  recovering_ = false;
   if (solved) {
     if (substepped) follow_substeps(steps.path, steps.done, hs);
+    recovering_ = recover_penetrations(steps);
     output_->add_work(steps.work);
   }
   // the history: the last substep's impulses and (compliance material) its springs
-  overflow_count_ += history_.store(found, res.lambda, model.rows, hs, atom->nlocal,
+  overflow_count_ += history_.store(found.tags, sys.contacts(), res.lambda, model.rows, hs,
                                     steps.springs.empty() ? nullptr : &steps.springs);
-  report_step(steps, found, any, solved);
+  report_step(steps, found.tags, any, solved);
   check_finite("velocity", atom->v, 3);
   check_finite("angular velocity", atom->omega, 3);
 }

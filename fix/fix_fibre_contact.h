@@ -78,16 +78,16 @@ class FixFibreContact : public Fix {
   bool step_moves(const std::vector<fibre::Body> &bodies,
                   const std::vector<fibre::Contact> &contacts, double hs) const;
   void follow_substeps(const fibre::Vector &path, int n, double hs);
+  bool recover_penetrations(const fibre::Substeps &steps);
   int step_substeps();
   std::string step_advice(double t_c) const;
   double simulated_time() const;
-  void tally_wall_loads(const fibre::ContactSystem &sys,
-                        const std::vector<fibre::DetectedContact> &found,
+  void tally_wall_loads(const fibre::ContactSystem &sys, const std::vector<fibre::ContactTag> &tags,
                         const fibre::Vector &lambda);
   void tally_virial(const fibre::ContactSystem &sys, const fibre::Vector &lambda);
   void warn_skin();
   void warn_deep_overlaps(const std::vector<fibre::Body> &bodies,
-                          const std::vector<fibre::DetectedContact> &found, double max_recovery);
+                          const std::vector<fibre::Contact> &contacts, double max_recovery);
   fibre::StepResult solve(fibre::ContactSystem &sys, const fibre::Vector &warm,
                           const fibre::StepOptions &opt, fibre::SweepCache *cache);
   void check_step(const fibre::Substeps &steps, int substeps, const fibre::SpookParams &params,
@@ -95,10 +95,9 @@ class FixFibreContact : public Fix {
                   fibre::Vector warm);
   void update_velocities(const fibre::Vector *dv);
   fibre::SpookParams step_params(const std::vector<fibre::Body> &bodies, double h) const;
-  fibre::Substeps solve_contacts(std::vector<fibre::Body> bodies,
-                                 const std::vector<fibre::DetectedContact> &found, int &substeps,
-                                 double &hs);
-  void report_step(const fibre::Substeps &steps, const std::vector<fibre::DetectedContact> &found,
+  fibre::Substeps solve_contacts(std::vector<fibre::Body> bodies, fibre::FoundContacts &found,
+                                 int &substeps, double &hs);
+  void report_step(const fibre::Substeps &steps, const std::vector<fibre::ContactTag> &tags,
                    bool any, bool solved);
 
   fibre::Settings settings_;
@@ -109,6 +108,7 @@ class FixFibreContact : public Fix {
   double fastest_ = 0.0;     // the step's largest free speed of a sphere (smallest_body)
   bool skin_warned_ = false; // warn_skin, once a run
   bool first_step_ = true;
+  bool recovering_ = false;          // the last step opened rigid rows' penetrations (recovery.hpp)
   double step_logged_ = 0.0;         // the step whose ratio to the collision time the log states
   int substeps_logged_ = 0;          // and its substeps
   class Pair *pair_ = nullptr;       // pair style whose force computation this fix switched off

@@ -209,12 +209,11 @@ std::string FixFibreContact::step_advice(double t_c) const
 // At the first step of a run: overlaps deeper than kDeepOverlap of the smaller diameter are
 // removed at the recovery speed, over many steps; say so.
 void FixFibreContact::warn_deep_overlaps(const std::vector<fibre::Body> &bodies,
-                                         const std::vector<fibre::DetectedContact> &found,
+                                         const std::vector<fibre::Contact> &contacts,
                                          double max_recovery)
 {
   double deepest = 0.0;
-  for (const fibre::DetectedContact &fc : found) {
-    const fibre::Contact &c = fc.contact;
+  for (const fibre::Contact &c : contacts) {
     const double rmin =
         c.is_wall() ? bodies[c.a].radius : std::min(bodies[c.a].radius, bodies[c.b].radius);
     deepest = std::max(deepest, -c.gap / (2.0 * rmin));

@@ -135,5 +135,6 @@ fibre::SpookParams FixFibreContact::step_params(const std::vector<fibre::Body> &
   const fibre::ContactModel &model = settings_.model;
   fibre::SpookParams p{h, model.damping, model.max_recovery(h, r_min_)};
   p.bounce_speed = bounce_speed(bodies, h);
+  p.penetration_floor = recovering_ ? fibre::kPenetrationFloor : fibre::kPenetrationStart;
   return p;
 }

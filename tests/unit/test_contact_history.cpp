@@ -21,6 +21,18 @@ DetectedContact contact_on(int store, double key, const Vec3 &normal)
   return fc;
 }
 
+std::vector<ContactTag> tags_of(const std::vector<DetectedContact> &found)
+{
+  return std::vector<ContactTag>(found.begin(), found.end());
+}
+
+std::vector<Contact> contacts_of(const std::vector<DetectedContact> &found)
+{
+  std::vector<Contact> contacts;
+  for (const DetectedContact &fc : found) contacts.push_back(fc.contact);
+  return contacts;
+}
+
 } // namespace
 
 TEST(ContactHistory, StoreThenWarmStartGivesTheImpulsesBack)
@@ -33,13 +45,13 @@ TEST(ContactHistory, StoreThenWarmStartGivesTheImpulsesBack)
                                         contact_on(2, 9.0, Vec3(0.3, -0.2, 1))};
   Vector lambda(18);
   for (int k = 0; k < 18; ++k) lambda[k] = 0.1 * (k + 1);
-  EXPECT_EQ(hist.store(found, lambda, 6, h, 4), 0);
-  const Vector warm = hist.warm_start(found, 6, h);
+  EXPECT_EQ(hist.store(tags_of(found), contacts_of(found), lambda, 6, h), 0);
+  const Vector warm = hist.warm_start(tags_of(found), contacts_of(found), 6, h);
   EXPECT_LT((warm - lambda).norm(), 1e-14 * lambda.norm());
   // released contacts (lambda_n <= 0) are not remembered
   lambda[6] = 0.0;
-  hist.store(found, lambda, 6, h, 4);
-  const Vector warm2 = hist.warm_start(found, 6, h);
+  hist.store(tags_of(found), contacts_of(found), lambda, 6, h);
+  const Vector warm2 = hist.warm_start(tags_of(found), contacts_of(found), 6, h);
   EXPECT_EQ(warm2.segment(6, 6).norm(), 0.0);
   EXPECT_LT((warm2.head(6) - lambda.head(6)).norm(), 1e-14);
 }
@@ -54,9 +66,9 @@ TEST(ContactHistory, WarmStartFollowsTheWorldFrame)
   std::vector<DetectedContact> found = {contact_on(0, 5.0, Vec3::UnitZ())};
   Vector lambda = Vector::Zero(3);
   lambda[0] = 2.0; // along +z
-  hist.store(found, lambda, 3, h, 1);
+  hist.store(tags_of(found), contacts_of(found), lambda, 3, h);
   found[0] = contact_on(0, 5.0, Vec3::UnitX());
-  const Vector warm = hist.warm_start(found, 3, h);
+  const Vector warm = hist.warm_start(tags_of(found), contacts_of(found), 3, h);
   EXPECT_NEAR(warm[0], 0.0, 1e-15); // the normal row sees no force now
   const Contact &k = found[0].contact;
   EXPECT_NEAR(warm[1], 2.0 * k.t1.z(), 1e-15);
@@ -71,7 +83,7 @@ TEST(ContactHistory, PackUnpackCopyAndClear)
   std::vector<DetectedContact> found = {contact_on(1, 4.0, Vec3::UnitZ()),
                                         contact_on(1, 6.0, Vec3::UnitY())};
   Vector lambda = Vector::Ones(6);
-  hist.store(found, lambda, 3, 1.0, 3);
+  hist.store(tags_of(found), contacts_of(found), lambda, 3, 1.0);
   EXPECT_EQ(hist.packed_size(1), 1 + 2 * ContactHistory::kSlotSize);
   double buf[ContactHistory::kMaxPacked];
   EXPECT_EQ(hist.pack(1, buf), hist.packed_size(1));
@@ -79,7 +91,7 @@ TEST(ContactHistory, PackUnpackCopyAndClear)
   // migration: unpack into another atom, then the warm start reads it there
   EXPECT_EQ(hist.unpack(2, buf), hist.packed_size(1));
   for (DetectedContact &fc : found) fc.store = 2;
-  EXPECT_LT((hist.warm_start(found, 3, 1.0) - lambda).norm(), 1e-15);
+  EXPECT_LT((hist.warm_start(tags_of(found), contacts_of(found), 3, 1.0) - lambda).norm(), 1e-15);
   // a restart record cut short keeps only whole slots
   EXPECT_EQ(hist.unpack(0, buf, ContactHistory::kSlotSize + 3), 1 + ContactHistory::kSlotSize);
   EXPECT_EQ(hist.packed_size(0), 1 + ContactHistory::kSlotSize);
@@ -106,9 +118,9 @@ TEST(ContactHistory, OverflowIsCountedNotStored)
   for (int k = 0; k < ContactHistory::kMaxSlots + 3; ++k)
     found.push_back(contact_on(0, 10.0 + k, Vec3::UnitZ()));
   const Vector lambda = Vector::Ones(3 * Eigen::Index(found.size()));
-  EXPECT_EQ(hist.store(found, lambda, 3, 1.0, 1), 3);
+  EXPECT_EQ(hist.store(tags_of(found), contacts_of(found), lambda, 3, 1.0), 3);
   EXPECT_EQ(hist.packed_size(0), ContactHistory::kMaxPacked);
-  const Vector warm = hist.warm_start(found, 3, 1.0);
+  const Vector warm = hist.warm_start(tags_of(found), contacts_of(found), 3, 1.0);
   EXPECT_EQ(warm.tail(9).norm(), 0.0); // the last three start cold
   EXPECT_LT((warm.head(3 * ContactHistory::kMaxSlots) - lambda.head(3 * ContactHistory::kMaxSlots))
                 .norm(),
@@ -129,9 +141,10 @@ TEST(ContactHistory, RoomGrowsWithTheMostContactsOnOneAtom)
   const int n = static_cast<int>(found.size());
   Vector lambda(6 * n);
   for (int k = 0; k < 6 * n; ++k) lambda[k] = 0.01 * (k + 1);
-  EXPECT_EQ(hist.store(found, lambda, 6, h, 3), 0);
+  EXPECT_EQ(hist.store(tags_of(found), contacts_of(found), lambda, 6, h), 0);
   EXPECT_GT(hist.memory_bytes(), before);
-  EXPECT_LT((hist.warm_start(found, 6, h) - lambda).norm(), 1e-14 * lambda.norm());
+  EXPECT_LT((hist.warm_start(tags_of(found), contacts_of(found), 6, h) - lambda).norm(),
+            1e-14 * lambda.norm());
   // atom 1's twelve values per slot travel to a new atom 2 whose history had one contact
   std::vector<double> buf(ContactHistory::kMaxPacked);
   EXPECT_EQ(hist.pack(1, buf.data()), 1 + 11 * ContactHistory::kSlotSize);
@@ -140,5 +153,31 @@ TEST(ContactHistory, RoomGrowsWithTheMostContactsOnOneAtom)
   EXPECT_EQ(other.unpack(2, buf.data()), 1 + 11 * ContactHistory::kSlotSize);
   std::vector<DetectedContact> moved(found.begin() + 2, found.end());
   for (DetectedContact &fc : moved) fc.store = 2;
-  EXPECT_LT((other.warm_start(moved, 6, h) - lambda.tail(6 * 11)).norm(), 1e-14 * lambda.norm());
+  EXPECT_LT(
+      (other.warm_start(tags_of(moved), contacts_of(moved), 6, h) - lambda.tail(6 * 11)).norm(),
+      1e-14 * lambda.norm());
+}
+
+// The history holds the stored contacts, not room for the most contacts on every atom: one
+// atom with 12 contacts among 100,000 atom places costs the per-atom index and its 12 slots.
+// Migration's copy shares slots that the next store rebuilds.
+TEST(ContactHistory, MemoryFollowsTheStoredContacts)
+{
+  const int places = 100000;
+  ContactHistory hist;
+  hist.grow(places);
+  std::vector<DetectedContact> found;
+  for (int k = 0; k < 12; ++k) found.push_back(contact_on(7, 10.0 + k, Vec3(k, 1, 2)));
+  const Vector lambda = Vector::Ones(3 * 12);
+  EXPECT_EQ(hist.store(tags_of(found), contacts_of(found), lambda, 3, 1.0), 0);
+  const double index = places * (sizeof(int) + sizeof(std::size_t));
+  EXPECT_LE(hist.memory_bytes(), index + 2 * 12 * ContactHistory::kSlotSize * sizeof(double));
+  hist.copy(7, places - 1); // atom 7 moves to the last place
+  hist.clear(7);
+  for (DetectedContact &fc : found) fc.store = places - 1;
+  EXPECT_LT((hist.warm_start(tags_of(found), contacts_of(found), 3, 1.0) - lambda).norm(), 1e-15);
+  EXPECT_EQ(hist.store(tags_of(found), contacts_of(found), 2.0 * lambda, 3, 1.0), 0);
+  EXPECT_LT((hist.warm_start(tags_of(found), contacts_of(found), 3, 1.0) - 2.0 * lambda).norm(),
+            1e-14);
+  EXPECT_EQ(hist.packed_size(7), 1);
 }

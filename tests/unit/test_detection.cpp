@@ -158,20 +158,25 @@ TEST(Detection, SortIsIndependentOfInputOrder)
     }
   std::vector<DetectedContact> shuffled = found;
   std::shuffle(shuffled.begin(), shuffled.end(), std::mt19937(7));
-  sort_contacts(found);
-  sort_contacts(shuffled);
-  for (std::size_t k = 0; k < found.size(); ++k) {
-    EXPECT_EQ(found[k].tag_a, shuffled[k].tag_a);
-    EXPECT_EQ(found[k].partner, shuffled[k].partner);
+  const FoundContacts sorted = sort_contacts(std::move(found));
+  const FoundContacts other = sort_contacts(std::move(shuffled));
+  ASSERT_EQ(sorted.tags.size(), 9u);
+  ASSERT_EQ(sorted.contacts.size(), 9u);
+  for (std::size_t k = 0; k < sorted.tags.size(); ++k) {
+    const ContactTag &t = sorted.tags[k];
+    EXPECT_EQ(t.tag_a, other.tags[k].tag_a);
+    EXPECT_EQ(t.partner, other.tags[k].partner);
+    EXPECT_EQ(t.gap, sorted.contacts[k].gap); // each tag beside its contact
+    EXPECT_EQ(t.gap, 0.1 * t.tag_a + t.partner);
     if (k > 0) {
-      EXPECT_LE(found[k - 1].tag_a, found[k].tag_a);
-      if (found[k - 1].tag_a == found[k].tag_a) {
-        EXPECT_LT(found[k - 1].partner, found[k].partner);
+      EXPECT_LE(sorted.tags[k - 1].tag_a, t.tag_a);
+      if (sorted.tags[k - 1].tag_a == t.tag_a) {
+        EXPECT_LT(sorted.tags[k - 1].partner, t.partner);
       }
     }
   }
-  EXPECT_EQ(found.front().tag_a, 1);
-  EXPECT_EQ(found.front().partner, -2.0);
+  EXPECT_EQ(sorted.tags.front().tag_a, 1);
+  EXPECT_EQ(sorted.tags.front().partner, -2.0);
 }
 
 // Dense tags (bucketed by tag) and sparse ones (a full sort) give the order of the keys.
@@ -192,12 +197,13 @@ TEST(Detection, SortOrdersByTagPartnerAndGap)
       return std::make_tuple(p.tag_a, p.partner, p.contact.gap) <
              std::make_tuple(q.tag_a, q.partner, q.contact.gap);
     });
-    sort_contacts(found);
-    ASSERT_EQ(found.size(), expected.size());
-    for (std::size_t k = 0; k < found.size(); ++k) {
-      EXPECT_EQ(found[k].tag_a, expected[k].tag_a) << "spread " << spread << ", contact " << k;
-      EXPECT_EQ(found[k].partner, expected[k].partner);
-      EXPECT_EQ(found[k].contact.gap, expected[k].contact.gap);
+    const FoundContacts sorted = sort_contacts(std::move(found));
+    ASSERT_EQ(sorted.tags.size(), expected.size());
+    for (std::size_t k = 0; k < sorted.tags.size(); ++k) {
+      EXPECT_EQ(sorted.tags[k].tag_a, expected[k].tag_a)
+          << "spread " << spread << ", contact " << k;
+      EXPECT_EQ(sorted.tags[k].partner, expected[k].partner);
+      EXPECT_EQ(sorted.contacts[k].gap, expected[k].contact.gap);
     }
   }
 }

@@ -1,5 +1,7 @@
 #include "fibre/algebra/cones.hpp"
 
+#include <algorithm>
+
 #include <cmath>
 
 #include "fibre/algebra/kernels.hpp"
@@ -20,6 +22,14 @@ Cones::Cones(const ContactSystem &sys)
     if (pull_.empty()) pull_.assign(std::size_t(sys.num_contacts()), 0.0);
     pull_[c] = h * k.pull;
   }
+}
+
+Cones Cones::frictionless(const ContactSystem &sys)
+{
+  Cones cones(sys);
+  std::fill(cones.coeff_.begin(), cones.coeff_.end(), 0.0);
+  cones.pull_.clear();
+  return cones;
 }
 
 std::vector<Vec6> row_scales(const ContactSystem &sys)

@@ -85,7 +85,7 @@ int cylinder_hit(const WallSpec &wall, const Body &b, double reach, PlaneHit &hi
   return 1;
 }
 
-void sort_contacts(std::vector<DetectedContact> &found)
+FoundContacts sort_contacts(std::vector<DetectedContact> &&found)
 {
   // Sort compact keys, then move each contact once: a Contact is a few hundred bytes, so
   // swapping them in the sort was 4% of a step, and reading the keys out of them in every
@@ -101,9 +101,8 @@ void sort_contacts(std::vector<DetectedContact> &found)
     return p.gap < q.gap;
   };
   const std::size_t n = found.size();
-  if (n < 2) return;
   std::vector<Key> keys(n);
-  long long lo = found[0].tag_a, hi = lo;
+  long long lo = n ? found[0].tag_a : 0, hi = lo;
   for (std::size_t i = 0; i < n; ++i) {
     keys[i] = {found[i].tag_a, found[i].partner, found[i].contact.gap, i};
     lo = std::min(lo, keys[i].tag_a);
@@ -127,10 +126,16 @@ void sort_contacts(std::vector<DetectedContact> &found)
   } else {
     std::sort(keys.begin(), keys.end(), before);
   }
-  std::vector<DetectedContact> sorted;
-  sorted.reserve(n);
-  for (const Key &k : keys) sorted.push_back(std::move(found[k.index]));
-  found.swap(sorted);
+  FoundContacts sorted;
+  sorted.contacts.reserve(n);
+  sorted.tags.reserve(n);
+  for (const Key &k : keys) {
+    const DetectedContact &fc = found[k.index];
+    sorted.contacts.push_back(fc.contact);
+    sorted.tags.push_back(fc);
+    sorted.tags.back().gap = fc.contact.gap;
+  }
+  return sorted;
 }
 
 } // namespace fibre

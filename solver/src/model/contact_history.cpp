@@ -6,33 +6,15 @@ namespace fibre {
 
 void ContactHistory::grow(int nmax)
 {
-  if (nmax > capacity()) relayout(nmax, per_atom_);
-}
-
-// Room for atoms [0, nmax) with `per_atom` slots each, the stored slots kept.
-void ContactHistory::relayout(int nmax, int per_atom)
-{
-  const int old = capacity();
-  const std::size_t stride = std::size_t(per_atom) * kSlotSize;
-  std::unique_ptr<double[]> room(new double[std::size_t(nmax) * stride]); // not filled
-  for (int i = 0; i < std::min(old, nmax); ++i)
-    std::copy(slots(i), slots(i) + count_[i] * kSlotSize, room.get() + std::size_t(i) * stride);
-  slots_ = std::move(room);
-  per_atom_ = per_atom;
+  if (nmax <= capacity()) return;
   count_.resize(nmax, 0);
-}
-
-// Room for n slots on every atom (at most kMaxSlots): the layout grows with the most contacts
-// one atom stores, so that a deck whose atoms store few keeps a small history.
-void ContactHistory::reserve_slots(int n)
-{
-  if (n > per_atom_) relayout(capacity(), std::min(kMaxSlots, std::max(n, per_atom_ + 2)));
+  first_.resize(nmax, 0);
 }
 
 void ContactHistory::copy(int from, int to)
 {
   count_[to] = count_[from];
-  std::copy(slots(from), slots(from) + count_[from] * kSlotSize, slots(to));
+  first_[to] = first_[from];
 }
 
 int ContactHistory::pack(int i, double *buf) const
@@ -47,20 +29,19 @@ int ContactHistory::unpack(int i, const double *buf, int available, int slot_siz
   slot_size = std::clamp(slot_size, 1, kSlotSize);
   const int n = std::min(
       {kMaxSlots, std::max(0, static_cast<int>(buf[0])), std::max(0, available) / slot_size});
-  reserve_slots(n);
   count_[i] = n;
-  double *dst = slots(i);
-  for (int k = 0; k < n; ++k, dst += kSlotSize) {
+  first_[i] = pool_.size() / kSlotSize;
+  pool_.resize(pool_.size() + std::size_t(n) * kSlotSize, 0.0);
+  double *dst = pool_.data() + first_[i] * kSlotSize;
+  for (int k = 0; k < n; ++k, dst += kSlotSize)
     std::copy(buf + 1 + k * slot_size, buf + 1 + (k + 1) * slot_size, dst);
-    std::fill(dst + slot_size, dst + kSlotSize, 0.0);
-  }
   return 1 + n * slot_size;
 }
 
 double ContactHistory::memory_bytes() const
 {
-  return double(count_.capacity()) * sizeof(int) +
-         double(capacity()) * per_atom_ * kSlotSize * sizeof(double);
+  return double(count_.capacity()) * sizeof(int) + double(first_.capacity()) * sizeof(std::size_t) +
+         double(pool_.capacity() + spare_.capacity()) * sizeof(double);
 }
 
 const double *ContactHistory::find(int atom, double key) const
@@ -71,16 +52,16 @@ const double *ContactHistory::find(int atom, double key) const
   return nullptr;
 }
 
-Vector ContactHistory::warm_start(const std::vector<DetectedContact> &found, int rows,
-                                  double h) const
+Vector ContactHistory::warm_start(const std::vector<ContactTag> &tags,
+                                  const std::vector<Contact> &contacts, int rows, double h) const
 {
-  const int nc = static_cast<int>(found.size());
+  const int nc = static_cast<int>(tags.size());
   Vector warm = Vector::Zero(Eigen::Index(rows) * nc);
   for (int c = 0; c < nc; ++c) {
-    const double *slot = find(found[c].store, found[c].key);
+    const double *slot = find(tags[c].store, tags[c].key);
     if (!slot) continue;
     const Vec3 force(slot[1], slot[2], slot[3]), moment(slot[4], slot[5], slot[6]);
-    const Contact &k = found[c].contact;
+    const Contact &k = contacts[c];
     const Vec3 dirs[3] = {k.normal, k.t1, k.t2};
     for (int r = 0; r < rows; ++r)
       warm[Eigen::Index(rows) * c + r] = h * (r < 3 ? force.dot(dirs[r]) : moment.dot(dirs[r - 3]));
@@ -100,14 +81,14 @@ Vec3 into_plane(const Vec3 &v, const Vec3 &n)
 
 } // namespace
 
-void ContactHistory::load_springs(const std::vector<DetectedContact> &found,
+void ContactHistory::load_springs(const std::vector<ContactTag> &tags,
                                   std::vector<Contact> &contacts) const
 {
-  for (std::size_t c = 0; c < found.size(); ++c) {
+  for (std::size_t c = 0; c < tags.size(); ++c) {
     Contact &k = contacts[c];
     k.spring.fill(0.0);
     k.penetration = 0.0;
-    const double *slot = find(found[c].store, found[c].key);
+    const double *slot = find(tags[c].store, tags[c].key);
     k.touched = slot != nullptr;
     if (!slot) continue;
     const Vec3 tangential = into_plane(Vec3(slot[7], slot[8], slot[9]), k.normal);
@@ -121,48 +102,79 @@ void ContactHistory::load_springs(const std::vector<DetectedContact> &found,
   }
 }
 
-long ContactHistory::store(const std::vector<DetectedContact> &found, const Vector &lambda,
-                           int rows, double h, int nlocal,
-                           const std::vector<std::array<double, kMaxRows>> *springs)
+namespace {
+
+// Whether contact c leaves anything to remember: it pressed or pulled, or a penetration is left
+// to open no faster than it must (a cohesive contact that pulls has lambda_n < 0).
+bool to_store(const Vector &lambda, int rows, int c,
+              const std::vector<std::array<double, kMaxRows>> *springs)
 {
-  std::fill(count_.begin(), count_.begin() + nlocal, 0);
+  const double l0 = lambda[Eigen::Index(rows) * c];
+  return l0 > 0.0 || l0 < 0.0 || (springs && (*springs)[c][0] > 0.0);
+}
+
+} // namespace
+
+// slot <- contact k's force and torque on body a, its springs in the world frame, the
+// penetration left.
+void ContactHistory::write_slot(double *slot, double key, const Contact &k, const double *l,
+                                int rows, double h, const std::array<double, kMaxRows> *xi)
+{
+  const Vec3 force = (l[0] * k.normal + l[1] * k.t1 + l[2] * k.t2) / h;
+  Vec3 moment = Vec3::Zero();
+  if (rows == 6) moment = (l[3] * k.normal + l[4] * k.t1 + l[5] * k.t2) / h;
+  slot[0] = key;
+  Vec3 tangential = Vec3::Zero(), rolling = Vec3::Zero();
+  double twisting = 0.0;
+  if (xi) {
+    tangential = (*xi)[1] * k.t1 + (*xi)[2] * k.t2;
+    rolling = (*xi)[4] * k.t1 + (*xi)[5] * k.t2;
+    twisting = (*xi)[3];
+  }
+  for (int d = 0; d < 3; ++d) {
+    slot[1 + d] = force[d];
+    slot[4 + d] = moment[d];
+    slot[7 + d] = tangential[d];
+    slot[10 + d] = rolling[d];
+  }
+  slot[13] = twisting;
+  slot[14] = xi ? (*xi)[0] : 0.0;
+}
+
+long ContactHistory::store(const std::vector<ContactTag> &tags,
+                           const std::vector<Contact> &contacts, const Vector &lambda, int rows,
+                           double h, const std::vector<std::array<double, kMaxRows>> *springs)
+{
+  // count each atom's slots (the first kMaxSlots in the contacts' order), then lay them out
+  std::fill(count_.begin(), count_.end(), 0);
+  const int nc = static_cast<int>(tags.size());
+  std::vector<char> kept(nc, 0);
   long overflow = 0;
-  for (int c = 0; c < static_cast<int>(found.size()); ++c) {
-    const DetectedContact &fc = found[c];
-    const Contact &k = fc.contact;
-    const double *l = lambda.data() + Eigen::Index(rows) * c;
-    // released: nothing to remember, but a penetration that opens faster than it must (a
-    // cohesive contact that pulls has lambda_n < 0)
-    const double penetration = springs ? (*springs)[c][0] : 0.0;
-    if (!(l[0] > 0.0 || l[0] < 0.0) && !(penetration > 0.0)) continue;
-    const Vec3 force = (l[0] * k.normal + l[1] * k.t1 + l[2] * k.t2) / h;
-    Vec3 moment = Vec3::Zero();
-    if (rows == 6) moment = (l[3] * k.normal + l[4] * k.t1 + l[5] * k.t2) / h;
-    const int s = fc.store;
+  for (int c = 0; c < nc; ++c) {
+    if (!to_store(lambda, rows, c, springs)) continue;
+    const int s = tags[c].store;
     if (count_[s] >= kMaxSlots) {
       ++overflow;
       continue;
     }
-    reserve_slots(count_[s] + 1);
-    double *slot = slots(s) + std::size_t(count_[s]++) * kSlotSize;
-    slot[0] = fc.key;
-    Vec3 tangential = Vec3::Zero(), rolling = Vec3::Zero();
-    double twisting = 0.0;
-    if (springs) {
-      const std::array<double, kMaxRows> &xi = (*springs)[c];
-      tangential = xi[1] * k.t1 + xi[2] * k.t2;
-      rolling = xi[4] * k.t1 + xi[5] * k.t2;
-      twisting = xi[3];
-    }
-    for (int d = 0; d < 3; ++d) {
-      slot[1 + d] = force[d];
-      slot[4 + d] = moment[d];
-      slot[7 + d] = tangential[d];
-      slot[10 + d] = rolling[d];
-    }
-    slot[13] = twisting;
-    slot[14] = penetration;
+    ++count_[s];
+    kept[c] = 1;
   }
+  std::size_t total = 0;
+  for (int i = 0; i < capacity(); ++i) {
+    first_[i] = total;
+    total += count_[i];
+  }
+  spare_.resize(total * kSlotSize);
+  std::vector<int> filled(count_.size(), 0);
+  for (int c = 0; c < nc; ++c) {
+    if (!kept[c]) continue;
+    const int s = tags[c].store;
+    double *slot = spare_.data() + (first_[s] + filled[s]++) * kSlotSize;
+    write_slot(slot, tags[c].key, contacts[c], lambda.data() + Eigen::Index(rows) * c, rows, h,
+               springs ? &(*springs)[c] : nullptr);
+  }
+  pool_.swap(spare_);
   return overflow;
 }
 

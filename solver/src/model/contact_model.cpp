@@ -84,6 +84,22 @@ void track_penetration(const SpookParams &params, double explained_overlap, doub
   c.penetration = excess > params.h * params.max_recovery ? excess : 0.0;
 }
 
+// A rigid normal row's penetration (compliance auto, or a law without a stiffness): its whole
+// overlap, where it is more than twice the row's at its last load (eps F: SPOOK's rows at rest
+// overlap so), the step's closing and penetration_floor steps of recovery. The velocity
+// solve then asks it not to close, and the split recovery (step/recovery.hpp) opens it by a
+// displacement.
+void rigid_penetration(const SpookParams &params, double overlap, double approach,
+                       double last_force, Contact &c)
+{
+  c.penetration = 0.0; // not kept: the overlap and the load are all there is to go by
+  if (!(params.max_recovery > 0) || c.elastic[0]) return;
+  const double explained = 2.0 * c.compliance[0] * last_force +
+                           2.0 * params.h * std::abs(approach) +
+                           params.penetration_floor * params.h * params.max_recovery;
+  if (overlap > explained) c.penetration = overlap;
+}
+
 // A cohesive contact (cohesion.hpp): one whose bodies overlap, or a JKR contact that has
 // touched and is within its reach. Its normal row carries tension down to the pull-off force,
 // whatever the compliance; an enduring one does not bounce.
@@ -267,6 +283,9 @@ void apply_contact_model(const ContactModel &model, const SpookParams &params, d
     // bounce (without external forces bounce_speed is 0, and Newton's law on every contact of
     // a sheared pack threw its grains out of the cell).
     if (last_normal > 0.0) c.restitution = 0.0;
+    if (!model.compliance.material)
+      rigid_penetration(params, std::max(-c.gap, 0.0), normal_approach(bodies, c), last_normal / h,
+                        c);
     // a spring's displacement lives on elastic rows only
     for (int r = 0; r < kMaxRows; ++r)
       if (!c.elastic[r]) c.spring[r] = 0.0;

@@ -86,7 +86,9 @@ struct Contact {
   // into other bodies, a jump in size): a penetration, whose gap term is bounded as a rigid
   // row's, so that it is removed no faster than max_recovery (nor than the law's spring at the
   // row's compliance pushes), where the spring alone would release the overlap's whole energy
-  // within a few steps. It only shrinks (contact_model.cpp; the history keeps it).
+  // within a few steps. It only shrinks (contact_model.cpp; the history keeps it). A rigid
+  // normal row's penetration is its overlap, removed by the split recovery's displacement
+  // (step/recovery.hpp); its velocity row asks only that it does not close.
   double penetration = 0.0;
   // An elastic normal row relaxed as the law's Kelvin-Voigt element (spring 1 / eps, dashpot
   // time tau) by implicit Euler, G v+ (h + tau) + eps lambda / h = -gap: SPOOK's row at
@@ -179,6 +181,11 @@ struct SpookParams {
   // Approach speeds at or below this are plastic whatever the contact's restitution (resting
   // contacts must not bounce on the speed gravity adds in a step).
   double bounce_speed = 0.0;
+  // A rigid row's overlap is a penetration (step/recovery.hpp) beyond this many steps of
+  // max_recovery (and what its load and the step's closing explain): kPenetrationStart
+  // (contact_model.hpp) in a run's ordinary steps, kPenetrationFloor while penetrations are
+  // being recovered.
+  double penetration_floor = 10.0;
   // A contact's damping: its own when set (Contact::damping >= 0), else the system's.
   double damping_of(const Contact &c) const { return c.damping >= 0 ? c.damping : damping; }
   // Row r's: its spring's own (Contact::spring_damping) where it has one, else the contact's.
@@ -197,7 +204,7 @@ struct SpookParams {
   {
     const double cap = (1.0 - ups) * max_recovery;
     const auto bounded = [cap](double term) { return cap > 0 && term > cap ? cap : term; };
-    if (!elastic) return bounded(-4.0 / h * ups * gap);
+    if (!elastic) return bounded(-4.0 / h * ups * (gap + penetration)); // recovery.hpp
     if (!(penetration > 0)) return -4.0 / h * ups * gap;
     return -4.0 / h * ups * (gap + penetration) + bounded(4.0 / h * ups * penetration);
   }

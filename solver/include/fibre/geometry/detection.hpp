@@ -119,18 +119,32 @@ int plane_hits(const WallSpec &wall, const Body &b, double reach, PlaneHit hits[
 // towards the axis and the centre's distance from the surface. Returns 0 or 1.
 int cylinder_hit(const WallSpec &wall, const Body &b, double reach, PlaneHit &hit);
 
-// One contact found by a front end, before the system is built.
-struct DetectedContact {
-  Contact contact;
+// What a step keeps of a found contact besides its Contact: the tags that order it, its wall,
+// the atom that stores its history and the key it is stored under, and its gap as found (the
+// system's advances over substeps).
+struct ContactTag {
   long long tag_a = 0; // the tag of body a (the smaller tag of a pair)
   double partner = 0;  // tag of body b or of an obstacle atom (> 0), or wall_key() (< 0)
   int wall = -1;       // index of the wall, else -1
   int store = -1;      // local atom that keeps the contact's warm start
   double key = 0;      // the key under which `store` keeps it: the other side's tag or key
+  double gap = 0;
+};
+
+// One contact found by a front end, before the system is built.
+struct DetectedContact : ContactTag {
+  Contact contact;
+};
+
+// A step's contacts: tags[c] is contacts[c]'s. The contacts go into the system; the tags stay
+// for the history and the outputs.
+struct FoundContacts {
+  std::vector<Contact> contacts;
+  std::vector<ContactTag> tags;
 };
 
 // The one order of a step's contacts, independent of storage order and process count:
-// by tag_a, then partner, then gap.
-void sort_contacts(std::vector<DetectedContact> &found);
+// by tag_a, then partner, then gap; each contact moved once.
+FoundContacts sort_contacts(std::vector<DetectedContact> &&found);
 
 } // namespace fibre

@@ -40,38 +40,34 @@ class ContactHistory {
   double memory_bytes() const;
 
   // The step's warm start, rows per contact: lambda_r = h (F . d_r) with the stored force and
-  // torque and this step's frame (zero for contacts not stored).
-  Vector warm_start(const std::vector<DetectedContact> &found, int rows, double h) const;
+  // torque and this step's frame (zero for contacts not stored); tags[c] is contacts[c]'s.
+  Vector warm_start(const std::vector<ContactTag> &tags, const std::vector<Contact> &contacts,
+                    int rows, double h) const;
   // Contact::spring of every stored contact in this step's frame: the stored tangential and
   // rolling vectors turned into the new tangent plane with their length kept (LAMMPS's rule),
   // the twisting angle as it is; Contact::penetration, and Contact::touched (stored).
-  // `contacts` are the found ones, in their order.
-  void load_springs(const std::vector<DetectedContact> &found,
-                    std::vector<Contact> &contacts) const;
-  // Replaces every stored contact of atoms [0, nlocal) by this step's pressing (cohesive ones:
-  // or pulling) contacts, with
-  // their springs at the step's end (advance_springs, rows per contact, row 0 the penetration
-  // left; null: none).
-  // Returns how many did not fit (more than kMaxSlots on one atom).
-  long store(const std::vector<DetectedContact> &found, const Vector &lambda, int rows, double h,
-             int nlocal, const std::vector<std::array<double, kMaxRows>> *springs = nullptr);
+  void load_springs(const std::vector<ContactTag> &tags, std::vector<Contact> &contacts) const;
+  // Replaces every stored contact by this step's pressing (cohesive ones: or pulling)
+  // contacts, with their springs at the step's end (advance_springs, rows per contact, row 0
+  // the penetration left; null: none). Returns how many did not fit (more than kMaxSlots on
+  // one atom).
+  long store(const std::vector<ContactTag> &tags, const std::vector<Contact> &contacts,
+             const Vector &lambda, int rows, double h,
+             const std::vector<std::array<double, kMaxRows>> *springs = nullptr);
 
  private:
   const double *find(int atom, double key) const;
-  double *slots(int atom) const
-  {
-    return slots_.get() + std::size_t(atom) * std::size_t(per_atom_) * kSlotSize;
-  }
-  void relayout(int nmax, int per_atom);
-  void reserve_slots(int n);
+  static void write_slot(double *slot, double key, const Contact &k, const double *l, int rows,
+                         double h, const std::array<double, kMaxRows> *xi);
+  const double *slots(int atom) const { return pool_.data() + first_[atom] * kSlotSize; }
+  // Atom i's count_[i] slots start at slot first_[i] of pool_: the pool holds the stored
+  // contacts and no more (a layout per atom sized to the most contacts on one atom was 8 slots
+  // for each of LAMMPS's atom places, 40% of bench/scale's heap). store() rebuilds the pool
+  // in spare_ and swaps; unpack appends; copy shares an atom's slots, which are never written
+  // in place.
   std::vector<int> count_;
-  // per_atom_ slots per atom, of which the first count_ are set: as many as the most that one
-  // atom has stored here (and 2 more), at most kMaxSlots. bench/scale's dense bed stores at
-  // most 7 or 8 on an atom, where a full kMaxSlots made the history 40% of its heap. Not
-  // zero-filled: LAMMPS grows per-atom arrays by 16384 atoms at a time, and filling that room
-  // (29 MB) cost 8% of a 3 s material run in page faults; untouched room is never read.
-  int per_atom_ = 4;
-  std::unique_ptr<double[]> slots_;
+  std::vector<std::size_t> first_;
+  std::vector<double> pool_, spare_;
 };
 
 } // namespace fibre

@@ -1,0 +1,29 @@
+// Split recovery of rigid rows' penetrations (design notes, "Penetrations"). A rigid normal row
+// whose overlap is more than a step's recovery and closing explain (Contact::penetration, set
+// by the contact model) asks the velocity solve for no separation, and the overlap is removed
+// by a displacement of the bodies of at most max_recovery * h a step, which adds no velocity.
+// A sphere caged in others (created inside a bed) has no rigid solution that separates it:
+// asked to separate at max_recovery, the velocity solve threw it out at up to 93 m/s; the
+// displacement only moves it as far as its cage lets it. Bullet's and PhysX's split impulse
+// keep penetration recovery out of the velocity solve for the same reason.
+#pragma once
+
+#include "fibre/core/exchange.hpp"
+#include "fibre/core/system.hpp"
+
+namespace fibre {
+
+// Whether a contact of any process has a rigid row's penetration (collective).
+bool has_rigid_penetration(const ContactSystem &sys, const Exchange &ex);
+
+// The displacement of every body (6 per body, owned and ghosts; the rotations zero) that opens
+// the rigid rows' penetrations left after the step (the gaps advanced by h G v_plus) by at most
+// h max_recovery, without closing any other contact by more than its gap: the frictionless
+// impulse problem G M^-1 G^T mu + Sigma mu = b, mu >= 0, in at most max_sweeps sweeps, and each
+// body's displacement at most h max_recovery (a cage with no room ends the sweeps unconverged,
+// with impulses that grow). Collective; false, dx untouched, where no process has a
+// penetration.
+bool recovery_displacement(const ContactSystem &sys, const Exchange &ex, const Vector &v_plus,
+                           Vector &dx, int max_sweeps = 100);
+
+} // namespace fibre
