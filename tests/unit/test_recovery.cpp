@@ -1,0 +1,96 @@
+// The split recovery of rigid rows' penetrations (step/recovery.hpp) against analytic cases:
+// an isolated pair opens by a step of max_recovery (less the rows' regularization), split by
+// the masses, without a velocity; a shallow overlap is left to the velocity rows; a sphere
+// caged between two walls has no room, and it moves no more than a step of max_recovery.
+#include <gtest/gtest.h>
+
+#include <vector>
+
+#include "fibre/core/exchange.hpp"
+#include "fibre/model/contact_model.hpp"
+#include "fibre/step/recovery.hpp"
+
+using namespace fibre;
+
+namespace {
+
+Body sphere(double x, double mass)
+{
+  Body b;
+  b.mass = mass;
+  b.radius = 0.5;
+  b.x = Vec3(x, 0, 0);
+  return b;
+}
+
+SpookParams params()
+{
+  SpookParams p;
+  p.h = 1e-3;
+  p.max_recovery = 5.0; // a step of it: 0.005
+  return p;
+}
+
+// compliance auto's contact model on the contacts (rigid rows, their penetrations)
+std::vector<Contact> modelled(const std::vector<Body> &bodies, std::vector<Contact> contacts)
+{
+  ContactModel model;
+  model.compliance.automatic = true;
+  apply_contact_model(model, params(), 1.0, bodies, contacts);
+  return contacts;
+}
+
+Vector at_rest(const std::vector<Body> &bodies)
+{
+  return Vector::Zero(6 * Eigen::Index(bodies.size()));
+}
+
+} // namespace
+
+TEST(Recovery, AnIsolatedPairOpensByAStepOfTheRecoverySpeed)
+{
+  // 20% of a diameter deep, masses 1 and 3: the lighter moves three quarters of the opening
+  const std::vector<Body> bodies{sphere(0.0, 1.0), sphere(0.8, 3.0)};
+  const std::vector<Contact> contacts = modelled(bodies, {sphere_sphere_contact(bodies, 1, 0)});
+  ASSERT_NEAR(contacts[0].penetration, 0.2, 1e-12);
+  const ContactSystem sys(bodies, contacts, 6, params());
+  Vector dx;
+  ASSERT_TRUE(recovery_displacement(sys, serial_exchange(), at_rest(bodies), dx));
+  // the opening: h max_recovery, less the rigid row's regularization Sigma (w mu + Sigma mu = b,
+  // w = 1/1 + 1/3), split 3 : 1 by the masses
+  const double w = 4.0 / 3.0, open = 0.005 * w / (w + sys.sigma()[0]);
+  EXPECT_NEAR(dx[6] - dx[0], open, 1e-12);
+  EXPECT_GT(open, 0.99 * 0.005);
+  EXPECT_NEAR(dx[0], -0.75 * open, 1e-12);
+  EXPECT_NEAR(dx[6], 0.25 * open, 1e-12);
+  EXPECT_NEAR(dx.segment<3>(3).norm() + dx.segment<3>(9).norm(), 0.0, 1e-15); // no rotation
+  EXPECT_NEAR(dx[1] + dx[2] + dx[7] + dx[8], 0.0, 1e-15);
+}
+
+TEST(Recovery, AShallowOverlapIsLeftToTheRows)
+{
+  // 2% of a diameter: below kPenetrationStart steps of recovery (0.05)
+  const std::vector<Body> bodies{sphere(0.0, 1.0), sphere(0.98, 1.0)};
+  const std::vector<Contact> contacts = modelled(bodies, {sphere_sphere_contact(bodies, 1, 0)});
+  EXPECT_EQ(contacts[0].penetration, 0.0);
+  const ContactSystem sys(bodies, contacts, 6, params());
+  Vector dx;
+  EXPECT_FALSE(recovery_displacement(sys, serial_exchange(), at_rest(bodies), dx));
+  EXPECT_EQ(dx.size(), 0);
+}
+
+TEST(Recovery, ACagedSphereMovesNoMoreThanAStep)
+{
+  // a sphere between two walls 0.8 apart, overlapping both by 0.1: they cannot both open, the
+  // sweeps end unconverged and the scaled displacement stays within a step of recovery
+  std::vector<Body> bodies{sphere(0.0, 1.0)};
+  std::vector<Contact> contacts{sphere_wall_contact(bodies, 0, Vec3::UnitX(), 0.4),
+                                sphere_wall_contact(bodies, 0, -Vec3::UnitX(), 0.4)};
+  contacts = modelled(bodies, contacts);
+  ASSERT_GT(contacts[0].penetration, 0.0);
+  const ContactSystem sys(bodies, contacts, 6, params());
+  Vector dx;
+  ASSERT_TRUE(recovery_displacement(sys, serial_exchange(), at_rest(bodies), dx));
+  EXPECT_LE(dx.head<3>().norm(), 0.005 * (1 + 1e-12));
+  EXPECT_NEAR(dx[1] + dx[2], 0.0, 1e-15); // along the cage's axis only
+}
