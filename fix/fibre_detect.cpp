@@ -134,14 +134,14 @@ fibre::FoundContacts LammpsDetection::contacts(const std::vector<fibre::Body> &b
   for (std::size_t k = 0; k < bodies.size(); ++k) speed_[k] = fibre::free_speed(bodies[k], h);
   pair_contacts(bodies, h, damping, found);
   wall_contacts(bodies, h, damping, found);
-  // A rigid row's penetration is opened by a displacement of up to h recovery a step
+  // A rigid row's penetration is opened by a displacement of up to `recovery` a step
   // (fibre/step/recovery.hpp), which moves the bodies around it too: every body may move that
   // far, and the contacts it can then reach are kept (the displacement closes none of them).
   // Where the last step recovered, or some overlap is deeper than a penetration's start.
   double deep = recovering ? 1.0 : 0.0;
   if (recovery > 0 && !recovering) {
     for (const fibre::DetectedContact &fc : found)
-      if (-fc.contact.gap > fibre::kPenetrationStart * h * recovery) deep = 1.0;
+      if (-fc.contact.gap > fibre::kPenetrationStart * recovery) deep = 1.0;
     exchange_.max(&deep, 1);
   }
   if (impacts || deep > 0) {
@@ -149,7 +149,7 @@ fibre::FoundContacts LammpsDetection::contacts(const std::vector<fibre::Body> &b
     fibre::Vector kick = fibre::Vector::Zero(6 * Eigen::Index(nbody));
     if (impacts) impact_kicks(bodies, h, found, kick);
     kick_.resize(nbody);
-    for (int k = 0; k < nbody; ++k) kick_[k] = kick[6 * k] + (deep > 0 ? recovery : 0.0);
+    for (int k = 0; k < nbody; ++k) kick_[k] = kick[6 * k] + (deep > 0 ? recovery / h : 0.0);
     // the second pass adds what the kicks reach; the first pass's contacts stand
     pair_contacts(bodies, h, damping, found);
     wall_contacts(bodies, h, damping, found);

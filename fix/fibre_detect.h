@@ -40,9 +40,10 @@ class LammpsDetection : protected LAMMPS_NS::Pointers {
   // Every contact this process keeps, in the library's order (fibre::sort_contacts).
   // impacts: contacts may bounce (restitution), so a body hit within the step may move faster
   // than its own velocity says; the contacts it can then reach are kept too (collective).
-  // recovery: the speed at which rigid rows' penetrations are opened (0: none); where the last
-  // step opened some (recovering) or a contact overlaps by more than kPenetrationStart steps of
-  // it, every body's reach grows by a step of it.
+  // recovery: how far the split recovery moves a body in a step at most, h_s max_recovery of
+  // the contact solve's step h_s (0: none); where the last step opened penetrations
+  // (recovering) or a contact overlaps by more than kPenetrationStart times it, every body's
+  // reach grows by it.
   fibre::FoundContacts contacts(const std::vector<fibre::Body> &bodies, double h, double damping,
                                 bool impacts = false, double recovery = 0.0,
                                 bool recovering = false);

@@ -511,10 +511,10 @@ void FixFibreContact::final_integrate()
   // substep moves on at its new speed in the others (without, a stiff pour blew up).
   int substeps = step_substeps();
   double hs = dtv_ / substeps;
-  const double recovery = step_params(bodies, hs).max_recovery;
+  const double recovery = model.max_recovery(hs, r_min_); // step_params's, without its sums
   fibre::FoundContacts found =
       detection_->contacts(bodies, dtv_, model.damping, model.may_bounce() || substeps > 1,
-                           model.compliance.material ? 0.0 : recovery, recovering_);
+                           model.compliance.material ? 0.0 : hs * recovery, recovering_);
   if (first_step_) warn_deep_overlaps(bodies, found.contacts, recovery);
   warn_skin();
   first_step_ = false;
