@@ -77,6 +77,15 @@ def sphere_box(box, types=1, boundary="f f f", processors=None):
     return lines + ["region box block %s units box" % box, "create_box %d box" % types]
 
 
+def cubic_bed(width, height):
+    """The deck lines of a simple cubic bed of unit spacing filling 0..width x 0..width x
+    0..height (region `bed`), the centres at half-integers: spheres of d = 1 touch each other
+    and the walls at 0 and width."""
+    return "\n".join(["lattice sc 1.0", "region bed block 0 %g 0 %g 0 %g units box"
+                      % (width, width, height), "create_atoms 1 region bed",
+                      "displace_atoms all move 0.5 0.5 0.5 units box"])
+
+
 def stacked_column(diameters):
     """Spheres of these diameters stacked on z = 0 along the z axis, each touching the next:
     their centres' heights and the create_atoms and set lines (density 1) that make them."""

@@ -21,11 +21,8 @@ import fibre_e2e as e2e
 LAW = "hertz/material 1e6 0.3 0.3 tangential mindlin NULL 1.0 0.5 damping tsuji"
 WALL = "wall granular " + LAW
 
-DECK = "units si\n" + "\n".join(e2e.sphere_box("0 6 0 6 0 10", processors="{procs}")) + """
-lattice sc 1.0
-region bed block 0 6 0 6 0 3 units box
-create_atoms 1 region bed
-displace_atoms all move 0.5 0.5 0.5 units box
+DECK = "\n".join(["units si"] + e2e.sphere_box("0 6 0 6 0 10", processors="{procs}") +
+                 [e2e.cubic_bed(6, 3)]) + """
 set type 1 diameter 1.0
 set type 1 density 1.0
 pair_style granular

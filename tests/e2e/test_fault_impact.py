@@ -40,10 +40,7 @@ thermo {every}
 run {steps}
 """
 
-BED = """lattice sc 1.0
-region bed block 0 6 0 6 0 3 units box
-create_atoms 1 region bed
-displace_atoms all move 0.5 0.5 0.5 units box"""
+BED = e2e.cubic_bed(6, 3)
 
 
 def integrate(method, extra):
@@ -73,7 +70,8 @@ def main():
                 continue
             atoms, speeds, ke = run.column("Atoms"), run.column("c_fastest"), run.column("c_energy")
             ck.check(min(atoms) == max(atoms) and e2e.finite(speeds + ke),
-                     what + "nothing lost, nothing NaN", "%d to %d atoms" % (min(atoms), max(atoms)))
+                     what + "nothing lost, nothing NaN",
+                     "%d to %d atoms" % (min(atoms), max(atoms)))
             ck.check(min(run.column("c_lowest")) > 0.0 and max(run.column("c_highest")) < 11.0,
                      what + "no sphere through the floor or the ceiling",
                      "centres from %.4g to %.4g" % (min(run.column("c_lowest")),

@@ -11,7 +11,8 @@ namespace fibre {
 
 namespace {
 
-bool rigid_penetration(const Contact &c)
+// Whether the split recovery opens contact c: a rigid row's penetration.
+bool recovered(const Contact &c)
 {
   return c.penetration > 0 && !c.elastic[0];
 }
@@ -28,9 +29,8 @@ Vector recovery_rhs(const ContactSystem &sys, const Vector &v_plus)
   for (int c = 0; c < sys.num_contacts(); ++c) {
     const Contact &k = sys.contacts()[c];
     const Eigen::Index row = Eigen::Index(rows) * c;
-    const double wall = k.wall_moves() ? wall_rows(k)[0] : 0.0;
-    const double gap = k.gap + p.h * (Gv[row] - wall);
-    if (rigid_penetration(k))
+    const double gap = gap_after(k, p.h, Gv[row], sys.walls_move());
+    if (recovered(k))
       b[row] = std::min(std::max(-gap, 0.0) / p.h, p.max_recovery);
     else
       b[row] = std::min(-gap / p.h, 0.0);
@@ -42,7 +42,7 @@ Vector recovery_rhs(const ContactSystem &sys, const Vector &v_plus)
 
 bool has_rigid_penetration(const ContactSystem &sys, const Exchange &ex)
 {
-  double any = std::any_of(sys.contacts().begin(), sys.contacts().end(), rigid_penetration);
+  double any = std::any_of(sys.contacts().begin(), sys.contacts().end(), recovered);
   ex.max(&any, 1);
   return any > 0;
 }

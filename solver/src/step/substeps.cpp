@@ -81,8 +81,7 @@ Substeps run_substeps(int n, const ContactModel &model, const SpookParams &param
       sys.next_substep(
           [&](std::vector<Body> &b, std::vector<Contact> &c) {
             for (std::size_t k = 0; k < c.size(); ++k) {
-              const double wall = walls_move ? wall_rows(c[k])[0] : 0.0;
-              c[k].gap += h * (Gv[Eigen::Index(rows) * Eigen::Index(k)] - wall);
+              c[k].gap = gap_after(c[k], h, Gv[Eigen::Index(rows) * Eigen::Index(k)], walls_move);
               if (!springs.empty()) {
                 c[k].spring = springs[k];
                 c[k].penetration = springs[k][0];

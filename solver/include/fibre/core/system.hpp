@@ -136,6 +136,12 @@ struct Contact {
 // twist, roll1, roll2 (D the contact frame), the part of the relative velocity that the wall
 // contributes with a minus sign. Zero for a pair or a wall at rest.
 std::array<double, kMaxRows> wall_rows(const Contact &c);
+// Contact k's gap after a step h at its normal row's velocity Gv_n, less a moving wall's
+// (walls_move: ContactSystem::walls_move).
+inline double gap_after(const Contact &k, double h, double Gv_n, bool walls_move)
+{
+  return k.gap + h * (Gv_n - (walls_move ? wall_rows(k)[0] : 0.0));
+}
 
 // r_eff = ra rb / (ra + rb) for a pair, ra against a wall (b == nullptr).
 inline double effective_radius(double ra, const double *rb)
