@@ -119,7 +119,38 @@ def pour_figures(run):
     return {"atoms": blocks[-1][-1]["Atoms"], "ke": mean("KinEng"), "rke": mean("c_1")}
 
 
-# The LIGGGHTS tutorials shortened for the tests: each (old, new) replaces old's first
+def funnel_deck(text):
+    """granregion.funnel for both twins: its step printed (the deck computes it from the
+    collision time)."""
+    old = "timestep\t${dt}"
+    assert old in text
+    return text.replace(old, old + '\nprint "FUNNEL_STEP ${dt}"', 1)
+
+
+def funnel_figures(run):
+    """granregion.funnel: grains after the fill and after settling on the plug (none lost),
+    and in the discharge (the third run, the plug removed, grains leaving through the
+    bottom's open boundary) the grains left at the end and the mean flow rate while 10% to
+    60% of them have left (grains per time unit, fitted)."""
+    blocks = run["thermo"]
+    if len(blocks) < 3:
+        return {}
+    out = {"filled": blocks[0][-1]["Atoms"], "settled": blocks[1][-1]["Atoms"],
+           "left": blocks[2][-1]["Atoms"]}
+    n0 = blocks[2][0]["Atoms"]
+    window = [r for r in blocks[2] if 0.4 * n0 <= r["Atoms"] <= 0.9 * n0]
+    step = re.search(r"^FUNNEL_STEP (\S+)", run["log"], re.M)
+    if len(window) >= 3 and step:
+        # the least-squares slope of the grains left against time over the window
+        t = [r["Step"] * float(step.group(1)) for r in window]
+        n = [r["Atoms"] for r in window]
+        tm, nm = sum(t) / len(t), sum(n) / len(n)
+        slope = sum((a - tm) * (b - nm) for a, b in zip(t, n)) / sum((a - tm) ** 2 for a in t)
+        out["rate"] = -slope
+    return out
+
+
+# The LIGGGHTS tutorials and LAMMPS's funnel shortened for the tests: each (old, new) replaces old's first
 # occurrence, in order, in both twins' text (after their DECKS edits)
 SHORTER = {
     # three of the four insertions: 900 grains falling
@@ -138,6 +169,13 @@ SHORTER = {
                        ("run 15000", "run 1000")),
     # 510 grains on the chute, before any reaches its end
     "chute_wear": (("run    100000 upto", "run 40000 upto"),),
+    # LAMMPS's funnel: 400 grains at four times the step (0.03 collision times, as native
+    # keeps the deck's physics there), landed on the plug, then 10.5 time units of discharge
+    "granregion.funnel": (("dt equal ${tcol}*0.05", "dt equal ${tcol}*0.2"),
+                          ("logfreq equal 1000", "logfreq equal 250"),
+                          ("pour 2000 1 42424", "pour 400 1 42424"),
+                          ("run\t\t20000 ", "run 5000"), ("run\t\t150000", "run 20000"),
+                          ("run\t\t100000", "run 25000")),
 }
 
 
@@ -337,6 +375,8 @@ DECKS = {
     "pour.drum": ("lammps", "granular/in.pour.drum", same, with_drum_figures,
                   printed_figures),
     "pour": ("lammps", "pour/in.pour", same, same, pour_figures),
+    "granregion.funnel": ("lammps", "granregion/in.granregion.funnel", same, funnel_deck,
+                          funnel_figures),
     "cohesion.noCohesion": ("liggghts", "cohesion/in.noCohesion", same, bed_deck,
                             printed_figures),
     "cohesion.cohesion": ("liggghts", "cohesion/in.cohesion", same, bed_deck, printed_figures),
