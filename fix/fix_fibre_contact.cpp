@@ -405,12 +405,14 @@ void FixFibreContact::update_velocities(const fibre::Vector *dv)
   }
 }
 
-// Rigid rows' penetrations: opened by a displacement that the next step's move takes, not by
-// a velocity (fibre/step/recovery.hpp). Whether there were any.
-bool FixFibreContact::recover_penetrations(const fibre::Substeps &steps)
+// Deep penetrations: opened by a displacement that the next step's move takes, not by a
+// velocity (fibre/step/recovery.hpp); the elastic rows' history keeps what is left of theirs.
+// Whether there were any.
+bool FixFibreContact::recover_penetrations(fibre::Substeps &steps)
 {
   fibre::Vector dx;
-  if (!fibre::recovery_displacement(steps.system, *exchange_, steps.v_plus, dx)) return false;
+  if (!fibre::recovery_displacement(steps.system, *exchange_, steps.v_plus, dtv_, dx)) return false;
+  fibre::take_opening(steps.system, dx, steps.springs);
   const std::vector<int> &body_atom = exchange_->body_atom();
   for (int k = 0; k < exchange_->num_owned(); ++k)
     for (int d = 0; d < 3; ++d) pending_[body_atom[k]][d] += dx[6 * k + d];
@@ -512,9 +514,12 @@ void FixFibreContact::final_integrate()
   int substeps = step_substeps();
   double hs = dtv_ / substeps;
   const double recovery = model.max_recovery(hs, r_min_); // step_params's, without its sums
+  // (compliance material: the elastic rows' penetrations are split once the contact model has
+  // found them, so detection reaches further while they are recovered)
+  const bool reach = !model.compliance.material || recovering_;
   fibre::FoundContacts found =
       detection_->contacts(bodies, dtv_, model.damping, model.may_bounce() || substeps > 1,
-                           model.compliance.material ? 0.0 : hs * recovery, recovering_);
+                           reach ? hs * recovery : 0.0, recovering_);
   if (first_step_) warn_deep_overlaps(bodies, found.contacts, recovery);
   warn_skin();
   first_step_ = false;

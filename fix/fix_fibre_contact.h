@@ -78,7 +78,7 @@ class FixFibreContact : public Fix {
   bool step_moves(const std::vector<fibre::Body> &bodies,
                   const std::vector<fibre::Contact> &contacts, double hs) const;
   void follow_substeps(const fibre::Vector &path, int n, double hs);
-  bool recover_penetrations(const fibre::Substeps &steps);
+  bool recover_penetrations(fibre::Substeps &steps);
   int step_substeps();
   std::string step_advice(double t_c) const;
   double simulated_time() const;

@@ -224,9 +224,13 @@ void FixFibreContact::warn_deep_overlaps(const std::vector<fibre::Body> &bodies,
          "Fix fibre_contact: the run starts with overlaps of up to " +
              fibre::format_g(100.0 * deepest) +
              "% of a diameter; they are removed at recovery_speed " +
-             (max_recovery > 0 ? fibre::format_g(max_recovery) +
-                                     " at most (and no faster than the material's spring)"
-                               : "none (SPOOK removes any overlap within a few steps)"));
+             (max_recovery > 0
+                  ? fibre::format_g(max_recovery) +
+                        " at most: by a displacement that adds no velocity where deeper than " +
+                        fibre::format_g(fibre::kPenetrationStart) +
+                        " steps of it, else by the contacts (no faster than the material's "
+                        "spring)"
+                  : "none (SPOOK removes any overlap within a few steps)"));
 }
 
 // A sphere that moves farther in a step than the neighbor skin may meet spheres that the

@@ -3,18 +3,12 @@ check): 30 spheres, one every 50 steps, into the region of a simple cubic bed of
 density 1, hertz/material E = 1e6, Mindlin, tsuji, walls of the same material, gravity, open
 top), up to 45% of a diameter into the bed's spheres; 2 s at 1e-3 s.
 
-Pass rule, compliance auto (rigid rows, the split recovery), serial and on two processes:
-nothing lost or NaN; no sphere faster than twice the recovery speed plus a fall through the
-box's height; the deepest overlap at the end below 1% of a diameter. Native LAMMPS at 1e-4 s runs
-the same deck for the record: it loses 121 of 174 and throws spheres at 61 m/s
-(doc/validation.md).
-
-Known fault (run with FIBRE_KNOWN_FAULTS=1): under compliance material the deposited spheres'
-penetrations are opened by their rows' velocities, whose cage has no room: spheres reach 11 m/s
-and 3 leave through the open top.
+Pass rule, compliance auto (rigid rows) and material (the law's springs), both with the split
+recovery, serial and on two processes: nothing lost or NaN; no sphere faster than twice the
+recovery speed plus a fall through the box's height; the deepest overlap at the end below 1% of
+a diameter. Native LAMMPS at 1e-4 s runs the same deck for the record: it loses 121 of 174 and
+throws spheres at 61 m/s (doc/validation.md).
 """
-
-import os
 
 import fibre_e2e as e2e
 
@@ -53,9 +47,7 @@ def main():
     ck = e2e.Checks("faults: fix deposit into a settled bed without an overlap check")
     recovery = 5.0  # the automatic recovery speed: 0.01 r_min / h
     bound = 2 * recovery + (2 * 9.81 * 10.0) ** 0.5  # and a fall through the box
-    cases = [("auto", 1), ("auto", 2)]
-    if os.environ.get("FIBRE_KNOWN_FAULTS") == "1":
-        cases.append(("material", 1))
+    cases = [("auto", 1), ("auto", 2), ("material", 1), ("material", 2)]
     for compliance, np in cases:
         deck = DECK.format(procs="2 1 1" if np == 2 else "1 1 1", dt=1e-3, every=50, steps=2000,
                            integrate=FIX.format(w=WALL, c=compliance))

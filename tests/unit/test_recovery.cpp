@@ -1,7 +1,10 @@
-// The split recovery of rigid rows' penetrations (step/recovery.hpp) against analytic cases:
-// an isolated pair opens by a step of max_recovery (less the rows' regularization), split by
-// the masses, without a velocity; a shallow overlap is left to the velocity rows; a sphere
-// caged between two walls has no room, and it moves no more than a step of max_recovery.
+// The split recovery of penetrations (step/recovery.hpp) against analytic cases: an isolated
+// pair opens by a step of max_recovery (less the rows' regularization), split by the masses,
+// without a velocity; a shallow overlap is left to the velocity rows; a sphere caged between
+// two walls has no room, and it moves no more than a step of max_recovery. Under compliance
+// material a new deep overlap is a penetration as a whole, opened as a rigid row's whatever the
+// law's softness; the spring keeps what the contact closes after it, and the history's
+// penetration shrinks by what the displacement opened.
 #include <gtest/gtest.h>
 
 #include <vector>
@@ -17,6 +20,7 @@ namespace {
 Body sphere(double x, double mass)
 {
   Body b;
+  b.type = 1;
   b.mass = mass;
   b.radius = 0.5;
   b.x = Vec3(x, 0, 0);
@@ -40,6 +44,21 @@ std::vector<Contact> modelled(const std::vector<Body> &bodies, std::vector<Conta
   return contacts;
 }
 
+// compliance material with one soft Hertz law (E about 1e5: Sigma is many times w)
+std::vector<Contact> material(const std::vector<Body> &bodies, std::vector<Contact> contacts)
+{
+  ContactModel model;
+  model.compliance.automatic = false;
+  model.compliance.material = true;
+  model.materials = MaterialTable(1);
+  PairCoefficients &law = model.materials.at(1, 1);
+  law.set = true;
+  law.normal = NormalLaw::hertz_material;
+  law.k_n = 1e5;
+  apply_contact_model(model, params(), 1.0, bodies, contacts);
+  return contacts;
+}
+
 Vector at_rest(const std::vector<Body> &bodies)
 {
   return Vector::Zero(6 * Eigen::Index(bodies.size()));
@@ -55,7 +74,7 @@ TEST(Recovery, AnIsolatedPairOpensByAStepOfTheRecoverySpeed)
   ASSERT_NEAR(contacts[0].penetration, 0.2, 1e-12);
   const ContactSystem sys(bodies, contacts, 6, params());
   Vector dx;
-  ASSERT_TRUE(recovery_displacement(sys, serial_exchange(), at_rest(bodies), dx));
+  ASSERT_TRUE(recovery_displacement(sys, serial_exchange(), at_rest(bodies), sys.params().h, dx));
   // the opening: h max_recovery, less the rigid row's regularization Sigma (w mu + Sigma mu = b,
   // w = 1/1 + 1/3), split 3 : 1 by the masses
   const double w = 4.0 / 3.0, open = 0.005 * w / (w + sys.sigma()[0]);
@@ -75,7 +94,7 @@ TEST(Recovery, AShallowOverlapIsLeftToTheRows)
   EXPECT_EQ(contacts[0].penetration, 0.0);
   const ContactSystem sys(bodies, contacts, 6, params());
   Vector dx;
-  EXPECT_FALSE(recovery_displacement(sys, serial_exchange(), at_rest(bodies), dx));
+  EXPECT_FALSE(recovery_displacement(sys, serial_exchange(), at_rest(bodies), sys.params().h, dx));
   EXPECT_EQ(dx.size(), 0);
 }
 
@@ -90,7 +109,44 @@ TEST(Recovery, ACagedSphereMovesNoMoreThanAStep)
   ASSERT_GT(contacts[0].penetration, 0.0);
   const ContactSystem sys(bodies, contacts, 6, params());
   Vector dx;
-  ASSERT_TRUE(recovery_displacement(sys, serial_exchange(), at_rest(bodies), dx));
+  ASSERT_TRUE(recovery_displacement(sys, serial_exchange(), at_rest(bodies), sys.params().h, dx));
   EXPECT_LE(dx.head<3>().norm(), 0.005 * (1 + 1e-12));
   EXPECT_NEAR(dx[1] + dx[2], 0.0, 1e-15); // along the cage's axis only
+}
+
+TEST(Recovery, AnElasticPenetrationOpensAsARigidRow)
+{
+  const std::vector<Body> bodies{sphere(0.0, 1.0), sphere(0.8, 3.0)};
+  const std::vector<Contact> contacts = material(bodies, {sphere_sphere_contact(bodies, 1, 0)});
+  ASSERT_TRUE(contacts[0].elastic[0]);
+  ASSERT_NEAR(contacts[0].penetration, 0.2, 1e-12); // the whole overlap: no load explains it
+  const ContactSystem sys(bodies, contacts, 6, params());
+  const double w = 4.0 / 3.0;
+  ASSERT_GT(sys.sigma()[0], 2 * w); // the law's row alone would keep most of the opening
+  EXPECT_EQ(sys.params().gap_term(sys.contacts()[0], sys.params().upsilon()), 0.0); // no push
+  Vector dx;
+  ASSERT_TRUE(recovery_displacement(sys, serial_exchange(), at_rest(bodies), sys.params().h, dx));
+  // the rows rigid for the displacement (Sigma below 1e-4 w): a step of max_recovery, 3 : 1
+  const double open = dx[6] - dx[0];
+  EXPECT_NEAR(open, 0.005, 0.005 * 1e-4);
+  EXPECT_NEAR(dx[0], -0.75 * open, 1e-15);
+  // the history's penetration left shrinks by the opening
+  std::vector<std::array<double, kMaxRows>> springs(1);
+  springs[0][0] = contacts[0].penetration;
+  take_opening(sys, dx, springs);
+  EXPECT_NEAR(springs[0][0], 0.2 - open, 1e-12);
+}
+
+TEST(Recovery, AKnownElasticPenetrationLeavesTheClosingToTheSpring)
+{
+  // a penetration of 0.1 kept from the last step, the overlap now 0.2: the spring holds the
+  // 0.1 the contact closed since, and the penetration stays as it was
+  const std::vector<Body> bodies{sphere(0.0, 1.0), sphere(0.8, 1.0)};
+  Contact c = sphere_sphere_contact(bodies, 1, 0);
+  c.penetration = 0.1;
+  const std::vector<Contact> contacts = material(bodies, {c});
+  EXPECT_EQ(contacts[0].penetration, 0.1);
+  const ContactSystem sys(bodies, contacts, 6, params());
+  const SpookParams &p = sys.params();
+  EXPECT_NEAR(p.gap_term(sys.contacts()[0], p.upsilon()), 4.0 / p.h * p.upsilon() * 0.1, 1e-9);
 }

@@ -173,7 +173,14 @@ void apply_pair(const ContactModel &model, const PairCoefficients &pc, const Spo
     const double explained = cohesive_row(pc, reff, overlap, last_raw / h, c);
     track_penetration(params, explained, overlap, normal_approach(bodies, c), c);
   } else {
+    const bool known = c.penetration > 0;
     track_penetration(params, law_overlap(pc, reff, force), overlap, normal_approach(bodies, c), c);
+    // A deep new one is split (SpookParams::split_penetration) as a rigid row's is: its whole
+    // overlap, so that its spring holds no load's overlap in a cage the displacement cannot open
+    // (a sphere deposited into a bed then pushed its cage apart at 11 m/s). The spring then
+    // carries what the contact closes from there.
+    if (!known && c.penetration > params.penetration_floor * h * params.max_recovery)
+      c.penetration = overlap;
     const std::array<double, kMaxRows> rigid = c.compliance;
     // A penetration's row keeps the law's compliance at its overlap (its last force was the
     // recovery's), so that it leaves no faster than the law's spring would push it: a soft

@@ -1,6 +1,7 @@
 #include "fibre/step/recovery.hpp"
 
 #include <algorithm>
+#include <memory>
 
 #include "fibre/algebra/cones.hpp"
 #include "fibre/algebra/kernels.hpp"
@@ -11,15 +12,10 @@ namespace fibre {
 
 namespace {
 
-// Whether the split recovery opens contact c: a rigid row's penetration.
-bool recovered(const Contact &c)
-{
-  return c.penetration > 0 && !c.elastic[0];
-}
-
-// The target opening speed of each normal row: a penetration's overlap left after the step, at
-// most max_recovery; an open contact may close by its gap; a touching one not further.
-Vector recovery_rhs(const ContactSystem &sys, const Vector &v_plus)
+// The target opening speed of each normal row: a penetration's overlap left after the step (a
+// rigid row's whole overlap, an elastic row's penetration as far as the overlap still holds
+// it), at most max_recovery; an open contact may close by its gap; a touching one not further.
+Vector recovery_rhs(const ContactSystem &sys, const Vector &v_plus, double span)
 {
   const SpookParams &p = sys.params();
   const int rows = sys.rows();
@@ -30,45 +26,84 @@ Vector recovery_rhs(const ContactSystem &sys, const Vector &v_plus)
     const Contact &k = sys.contacts()[c];
     const Eigen::Index row = Eigen::Index(rows) * c;
     const double gap = gap_after(k, p.h, Gv[row], sys.walls_move());
-    if (recovered(k))
-      b[row] = std::min(std::max(-gap, 0.0) / p.h, p.max_recovery);
+    const double left = k.elastic[0] ? std::min(k.penetration, -gap) : -gap;
+    if (p.split_penetration(k))
+      b[row] = std::min(std::max(left, 0.0) / span, p.max_recovery);
     else
-      b[row] = std::min(-gap / p.h, 0.0);
+      b[row] = std::min(-gap / span, 0.0);
   }
   return b;
 }
 
+// The system with its elastic normal rows rigid, or null where it has none: the displacement
+// neither compresses a law's spring (a caged sphere's neighbours, pushed into theirs, stored
+// the energy that threw the cage apart at 11 m/s) nor leaves Sigma's share of a penetration's
+// opening. A rigid row's Sigma is 1e-4 of its G M^-1 G^T (compliance auto's is about 0.01).
+std::unique_ptr<ContactSystem> rigid_rows(const ContactSystem &sys)
+{
+  const std::vector<Contact> &contacts = sys.contacts();
+  if (std::none_of(contacts.begin(), contacts.end(), [](const Contact &c) { return c.elastic[0]; }))
+    return nullptr;
+  const double h = sys.params().h;
+  std::vector<Contact> rigid = contacts;
+  for (std::size_t c = 0; c < rigid.size(); ++c) {
+    const std::array<Vec6, 2> &sides = sys.diagonal_sides(static_cast<int>(c));
+    if (rigid[c].elastic[0]) rigid[c].compliance[0] = 1e-4 * h * h * (sides[0][0] + sides[1][0]);
+  }
+  return std::make_unique<ContactSystem>(sys.bodies(), std::move(rigid), sys.rows(), sys.params(),
+                                         sys.num_owned_bodies());
+}
+
 } // namespace
 
-bool has_rigid_penetration(const ContactSystem &sys, const Exchange &ex)
+bool has_split_penetration(const ContactSystem &sys, const Exchange &ex)
 {
-  double any = std::any_of(sys.contacts().begin(), sys.contacts().end(), recovered);
+  const SpookParams &p = sys.params();
+  double any = std::any_of(sys.contacts().begin(), sys.contacts().end(),
+                           [&p](const Contact &c) { return p.split_penetration(c); });
   ex.max(&any, 1);
   return any > 0;
 }
 
 bool recovery_displacement(const ContactSystem &sys, const Exchange &ex, const Vector &v_plus,
-                           Vector &dx, int max_sweeps)
+                           double span, Vector &dx, int max_sweeps)
 {
-  if (!has_rigid_penetration(sys, ex)) return false;
-  const Cones frictionless = Cones::frictionless(sys);
-  const Vector b = recovery_rhs(sys, v_plus);
+  if (!has_split_penetration(sys, ex)) return false;
+  const std::unique_ptr<ContactSystem> rigid = rigid_rows(sys);
+  const ContactSystem &solved = rigid ? *rigid : sys;
+  const Cones frictionless = Cones::frictionless(solved);
+  const Vector b = recovery_rhs(sys, v_plus, span);
   Vector mu = Vector::Zero(sys.contact_dofs());
   PgsControl control;
   control.max_sweeps = max_sweeps;
   control.tol = 1e-3;
-  pgs(sys, ex, frictionless, b, row_scales(sys), mu, control);
-  dx = velocity_change(sys, ex, mu);
-  const double h = sys.params().h, reach = h * sys.params().max_recovery;
+  pgs(solved, ex, frictionless, b, row_scales(solved), mu, control);
+  dx = velocity_change(solved, ex, mu);
+  const double reach = span * sys.params().max_recovery;
   double fastest = 0.0;
   for (int i = 0; i < sys.num_bodies(); ++i) {
     Eigen::Ref<Vector> body = dx.segment(6 * Eigen::Index(i), 6);
     body.tail<3>().setZero();
-    fastest = std::max(fastest, h * body.head<3>().norm());
+    fastest = std::max(fastest, span * body.head<3>().norm());
   }
   ex.max(&fastest, 1);
-  dx *= fastest > reach ? h * reach / fastest : h;
+  dx *= fastest > reach ? span * reach / fastest : span;
   return true;
+}
+
+void take_opening(const ContactSystem &sys, const Vector &dx,
+                  std::vector<std::array<double, kMaxRows>> &springs)
+{
+  if (springs.size() != std::size_t(sys.num_contacts())) return;
+  const SpookParams &p = sys.params();
+  Vector opening;
+  g_apply(sys, dx, opening);
+  const int rows = sys.rows();
+  for (int c = 0; c < sys.num_contacts(); ++c) {
+    const Contact &k = sys.contacts()[c];
+    if (k.elastic[0] && p.split_penetration(k))
+      springs[c][0] = std::max(0.0, springs[c][0] - opening[Eigen::Index(rows) * c]);
+  }
 }
 
 } // namespace fibre

@@ -199,26 +199,38 @@ struct SpookParams {
   {
     return r > 0 && c.spring_damping[r] >= 0 ? c.spring_damping[r] : damping_of(c);
   }
+  // Whether contact c's penetration is removed by the split recovery's displacement
+  // (step/recovery.hpp), not by its row's velocity: a rigid row's (the contact model sets it
+  // beyond penetration_floor steps of max_recovery), and an elastic row's beyond the same
+  // floor (shallower ones are pushed open by the row's bounded velocity, below).
+  bool split_penetration(const Contact &c) const
+  {
+    if (!(c.penetration > 0)) return false;
+    return !c.elastic[0] || c.penetration > penetration_floor * h * max_recovery;
+  }
   // The gap term of the normal row's rhs, -(4 / h) Upsilon g, bounded by max_recovery unless
   // the row is the material's spring (Contact::elastic[0]): bounding an elastic overlap would
   // bound the force the contact can carry, and a wedged sphere would stay deep in.
-  // An elastic row's penetration (Contact::penetration) is bounded as a rigid row's overlap.
+  // An elastic row's penetration (Contact::penetration) is bounded as a rigid row's overlap,
+  // or, split, left out: the row asks only that it does not close.
   // The bound is (1 - Upsilon) max_recovery: the row keeps Upsilon of its speed from step to
   // step (spook_rhs), so that its speed approaches max_recovery from below, where a bound of
   // max_recovery itself gave (1 + 4 d) / (4 d) times it.
-  double gap_term(double gap, double ups, bool elastic = false, double penetration = 0.0) const
+  double gap_term(double gap, double ups, bool elastic = false, double penetration = 0.0,
+                  bool split = false) const
   {
     const double cap = (1.0 - ups) * max_recovery;
     const auto bounded = [cap](double term) { return cap > 0 && term > cap ? cap : term; };
     if (!elastic) return bounded(-4.0 / h * ups * (gap + penetration)); // recovery.hpp
     if (!(penetration > 0)) return -4.0 / h * ups * gap;
+    if (split) return -4.0 / h * ups * (gap + penetration);
     return -4.0 / h * ups * (gap + penetration) + bounded(4.0 / h * ups * penetration);
   }
   double gap_term(double gap) const { return gap_term(gap, upsilon()); }
   // Contact c's: its gap with cohesion's shift, its elastic normal row and penetration.
   double gap_term(const Contact &c, double ups) const
   {
-    return gap_term(c.gap + c.gap_shift, ups, c.elastic[0], c.penetration);
+    return gap_term(c.gap + c.gap_shift, ups, c.elastic[0], c.penetration, split_penetration(c));
   }
   // The same term of an elastic row's displacement, unbounded (the cone bounds the spring).
   double spring_term(double displacement, double ups) const
