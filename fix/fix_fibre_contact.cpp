@@ -226,10 +226,12 @@ void FixFibreContact::tally_virial(const fibre::ContactSystem &sys, const fibre:
 {
   fibre::Virial global;
   fibre::Vector per_body;
-  fibre::contact_virial(sys, lambda, global, vflag_atom ? &per_body : nullptr);
-  if (vflag_global)
+  const bool atoms = evflag && vflag_atom;
+  fibre::contact_virial(sys, lambda, global, atoms ? &per_body : nullptr);
+  for (int i = 0; i < 6; ++i) held_virial_[i] = global[i];
+  if (evflag && vflag_global)
     for (int i = 0; i < 6; ++i) virial[i] += global[i];
-  if (!vflag_atom) return;
+  if (!atoms) return;
   exchange_->reverse_sum(per_body);
   const std::vector<int> &body_atom = exchange_->body_atom();
   for (int k = 0; k < exchange_->num_owned(); ++k)
@@ -281,12 +283,14 @@ void FixFibreContact::setup(int vflag)
   const Pair *gran = fibre_lmp::granular_pair(lmp, style);
   if (!gran || !gran->list)
     fail(error, FLERR, "Fix fibre_contact found no neighbor list of the pair style");
-  dtv_ = update->dt;
+  dtv_ = h_ = update->dt;
+  next_solve_ = 0; // a run starts with a solve
 }
 
 void FixFibreContact::reset_dt()
 {
-  dtv_ = update->dt;
+  dtv_ = h_ = update->dt;
+  next_solve_ = 0;
 }
 
 /* ----------------------------------------------------------------------
@@ -405,13 +409,55 @@ void FixFibreContact::update_velocities(const fibre::Vector *dv)
   }
 }
 
+// contact_every: the solve's impulses are applied at its step and the external forces f at
+// every step, so the positions of the `every` steps sum dt v+ less dt^2 f / m (every - 1) ...
+// 1: they take that in (pending_), and end where SPOOK's step every dt puts them,
+// x + every dt v+ (without, a sphere resting on a floor rose by that each solve and fell back
+// through its contact, which took the energy of the fall out).
+void FixFibreContact::follow_solve_step(int every)
+{
+  double **f = atom->f;
+  const double *rmass = atom->rmass;
+  const double shift = 0.5 * every * (every - 1) * dtv_ * dtv_;
+  const std::vector<int> &body_atom = exchange_->body_atom();
+  for (int k = 0; k < exchange_->num_owned(); ++k) {
+    const int i = body_atom[k];
+    for (int d = 0; d < 3; ++d) pending_[i][d] += shift * f[i][d] / rmass[i];
+  }
+}
+
+// A step between contact solves (contact_every): the external forces only; the virial is the
+// last solve's mean contact forces' (global only). Moving regions difference their motion
+// every step (LAMMPS's set_velocity divides the motion since its last call by dt).
+void FixFibreContact::hold_step()
+{
+  update_velocities(nullptr);
+  detection_->start_moving_walls();
+  if (evflag && vflag_global)
+    for (int i = 0; i < 6; ++i) virial[i] += held_virial_[i];
+}
+
+// The steps from this contact solve to the next (contact_every): N, or under auto the most
+// whose sum stays within kEveryCollisions of the law's shortest collision time (1 without one:
+// rigid rows). Alike on every process (m_min_ and r_min_ are global).
+int FixFibreContact::solve_interval() const
+{
+  if (settings_.contact_every > 0) return settings_.contact_every;
+  const fibre::ContactModel &model = settings_.model;
+  if (!model.compliance.material || !(m_min_ > 0 && r_min_ > 0)) return 1;
+  const double t_c = fibre::shortest_collision_time(model.materials, r_min_, m_min_, 1.0).t_c;
+  if (!(t_c > 0) || !(dtv_ > 0)) return 1;
+  const double steps = std::floor(kEveryCollisions * t_c / dtv_ * (1.0 + 1e-12));
+  return static_cast<int>(std::clamp(steps, 1.0, 1e6));
+}
+
 // Deep penetrations: opened by a displacement that the next step's move takes, not by a
 // velocity (fibre/step/recovery.hpp); the elastic rows' history keeps what is left of theirs.
 // Whether there were any.
 bool FixFibreContact::recover_penetrations(fibre::Substeps &steps)
 {
   fibre::Vector dx;
-  if (!fibre::recovery_displacement(steps.system, *exchange_, steps.v_plus, dtv_, dx)) return false;
+  if (!fibre::recovery_displacement(steps.system, *exchange_, steps.v_plus, h_, dx)) return false;
   fibre::take_opening(steps.system, dx, steps.springs);
   const std::vector<int> &body_atom = exchange_->body_atom();
   for (int k = 0; k < exchange_->num_owned(); ++k)
@@ -438,7 +484,7 @@ fibre::Substeps FixFibreContact::solve_contacts(std::vector<fibre::Body> bodies,
   history_.load_springs(found.tags, contacts);
   if (substeps > 1 && model.substep_moving_only && !step_moves(bodies, contacts, hs)) {
     substeps = 1;
-    hs = dtv_;
+    hs = h_;
     params = step_params(bodies, hs);
     warm = history_.warm_start(found.tags, contacts, model.rows, hs);
   }
@@ -503,22 +549,29 @@ void FixFibreContact::final_integrate()
   check_finite("velocity", atom->v, 3);
   check_finite("angular velocity", atom->omega, 3);
 
+  if (update->ntimestep < next_solve_) { // contact_every: the last solve's impulses hold
+    hold_step();
+    return;
+  }
   const fibre::ContactModel &model = settings_.model;
   std::vector<fibre::Body> bodies = detection_->bodies();
   detection_->set_wall_time(simulated_time() - time_origin_);
   smallest_body(bodies);
+  const int every = solve_interval();
+  h_ = every * dtv_;
+  next_solve_ = update->ntimestep + every;
   // the contact solve runs in substeps of hs (fibre/substeps.hpp); detection keeps the step.
   // Detection reaches as far as impacts may kick the bodies where they bounce, and with
   // substeps also where they do not: a sphere that a plastic impact kicks in the step's first
   // substep moves on at its new speed in the others (without, a stiff pour blew up).
   int substeps = step_substeps();
-  double hs = dtv_ / substeps;
+  double hs = h_ / substeps;
   const double recovery = model.max_recovery(hs, r_min_); // step_params's, without its sums
   // (compliance material: the elastic rows' penetrations are split once the contact model has
   // found them, so detection reaches further while they are recovered)
   const bool reach = !model.compliance.material || recovering_;
   fibre::FoundContacts found =
-      detection_->contacts(bodies, dtv_, model.damping, model.may_bounce() || substeps > 1,
+      detection_->contacts(bodies, h_, model.damping, model.may_bounce() || substeps > 1,
                            reach ? hs * recovery : 0.0, recovering_);
   if (first_step_) warn_deep_overlaps(bodies, found.contacts, recovery);
   warn_skin();
@@ -545,12 +598,14 @@ void FixFibreContact::final_integrate()
   const fibre::Vector lambda_mean =
       substepped ? fibre::Vector(steps.lambda / double(steps.done)) : res.lambda;
   tally_wall_loads(sys, found.tags, lambda_mean);
-  if (evflag) // this step's virial is wanted (post_force)
+  // this step's virial is wanted (post_force), or the steps' to the next solve
+  if (evflag || next_solve_ > update->ntimestep + 1)
     tally_virial(sys, lambda_mean.size() ? lambda_mean : fibre::Vector::Zero(sys.contact_dofs()));
   // the energy the moving walls put in and the contacts take out
   recovering_ = false;
   if (solved) {
     if (substepped) follow_substeps(steps.path, steps.done, hs);
+    if (every > 1) follow_solve_step(every);
     recovering_ = recover_penetrations(steps);
     output_->add_work(steps.work);
   }

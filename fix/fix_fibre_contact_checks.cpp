@@ -195,10 +195,16 @@ std::string FixFibreContact::step_advice(double t_c) const
 {
   const fibre::ContactModel &model = settings_.model;
   const double longest = model.substep_collisions * t_c;
-  if (model.substeps > 0 || !(dtv_ < 0.5 * longest)) return "";
+  if (model.substeps > 0 || settings_.contact_every != 1 || !(dtv_ < 0.5 * longest)) return "";
   const auto g = [](double x) { return fibre::format_g(x); };
-  return ". This deck could take a step of up to " + g(longest) + " (one substep of " +
-         g(model.substep_collisions) + " t_c), " + g(longest / dtv_) +
+  const int every = static_cast<int>(std::floor(kEveryCollisions * t_c / dtv_ * (1.0 + 1e-12)));
+  const std::string solves =
+      every > 1 ? ". This deck's contacts could be solved once every " + std::to_string(every) +
+                      " steps (" + g(kEveryCollisions) +
+                      " t_c), that many times fewer solves: give 'contact_every auto' (no other "
+                      "edit). Or it"
+                : ". This deck";
+  return solves + " could take a step of up to " + g(longest) + ", " + g(longest / dtv_) +
          " times this one, which takes that many times fewer steps: give 'timestep " + g(longest) +
          "' (or a round step below it) and scale the deck's step counts (run, thermo, dump, "
          "fix print, insertion every) by the same factor; fix move and wall wiggle follow time, "
@@ -237,7 +243,7 @@ void FixFibreContact::warn_deep_overlaps(const std::vector<fibre::Body> &bodies,
 // list, built at most a step ago, does not hold: it may pass through them. Said once a run.
 void FixFibreContact::warn_skin()
 {
-  const double skin = neighbor->skin, move = fastest_ * dtv_;
+  const double skin = neighbor->skin, move = fastest_ * h_;
   if (skin_warned_ || !(move > skin) || !(fastest_ > 0)) return;
   skin_warned_ = true;
   if (comm->me != 0) return;

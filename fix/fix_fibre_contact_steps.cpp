@@ -52,15 +52,18 @@ int FixFibreContact::step_substeps()
   fibre::PairCollisionTime shortest{};
   if (model.compliance.material && m_min_ > 0 && r_min_ > 0)
     shortest = fibre::shortest_collision_time(model.materials, r_min_, m_min_, 1.0);
-  const int n = fibre::substeps_for(model, dtv_, shortest.t_c);
-  if ((dtv_ == step_logged_ && n == substeps_logged_) || !(shortest.t_c > 0)) return n;
-  step_logged_ = dtv_;
+  const int n = fibre::substeps_for(model, h_, shortest.t_c);
+  if ((h_ == step_logged_ && n == substeps_logged_) || !(shortest.t_c > 0)) return n;
+  step_logged_ = h_;
   substeps_logged_ = n;
   if (comm->me != 0) return n;
   const auto g = [](double x) { return fibre::format_g(x); };
-  const double per = dtv_ / n / shortest.t_c;
+  const double per = h_ / n / shortest.t_c;
+  const std::string solve = h_ == dtv_ ? "the step " + g(dtv_)
+                                       : "the contact solve's step " + g(h_) + " (" + g(h_ / dtv_) +
+                                             " steps of " + g(dtv_) + ": contact_every)";
   std::string text =
-      "fix fibre_contact: the step " + g(dtv_) + " is " + g(dtv_ / shortest.t_c) +
+      "fix fibre_contact: " + solve + " is " + g(h_ / shortest.t_c) +
       " collision times of the pair style's law (t_c " + g(shortest.t_c) +
       ": two spheres of the smallest radius " + g(r_min_) + " and mass " + g(m_min_) +
       " meeting at 1 velocity unit, type pair " + std::to_string(shortest.i) + " " +
@@ -88,7 +91,7 @@ double FixFibreContact::bounce_speed(const std::vector<fibre::Body> &bodies, dou
   // Without external forces every approach would bounce, the new contacts of a sheared pack
   // too (it threw grains out of the shear cell): then the automatic overlap recovery speed of
   // the step (of a substep it would keep a head-on pair at 1 m/s from bouncing at 16 substeps).
-  return v > 0 ? v : model.recovery_radii * r_min_ / dtv_;
+  return v > 0 ? v : model.recovery_radii * r_min_ / h_;
 }
 
 // The speed above which a contact moves (step_moves) or bounces (bounce_speed): bounce_steps
@@ -107,7 +110,7 @@ bool FixFibreContact::step_moves(const std::vector<fibre::Body> &bodies,
                                  const std::vector<fibre::Contact> &contacts, double hs) const
 {
   const double speed = impact_speed(bodies, hs);
-  const fibre::SpookParams step{dtv_, settings_.model.damping};
+  const fibre::SpookParams step{h_, settings_.model.damping};
   int moves = fibre::step_moves(bodies, contacts, step, speed) ? 1 : 0;
   MPI_Allreduce(MPI_IN_PLACE, &moves, 1, MPI_INT, MPI_MAX, world);
   return moves != 0;

@@ -273,6 +273,12 @@ TEST(Settings, BadInputNamesTheKeywordAndItsForm)
   EXPECT_EQ(error_of("substeps"), "expected 'substeps auto|<integer 1 to 1000>'");
   EXPECT_EQ(error_of("substep_collisions 0"),
             "expected 'substep_collisions <positive number of collision times>', got '0'");
+  EXPECT_EQ(error_of("contact_every 0"),
+            "expected 'contact_every auto|<integer 1 to 1000000>', got '0'");
+  EXPECT_EQ(error_of("contact_every"), "expected 'contact_every auto|<integer 1 to 1000000>'");
+  EXPECT_EQ(parse_settings(words("contact_every 4")).contact_every, 4);
+  EXPECT_EQ(parse_settings(words("contact_every 4 contact_every auto")).contact_every, 0);
+  EXPECT_EQ(parse_settings(words("")).contact_every, 1);
   EXPECT_EQ(parse_settings(words("substeps 7")).model.substeps, 7);
   EXPECT_EQ(parse_settings(words("substeps 7 substeps auto")).model.substeps, 0);
   EXPECT_DOUBLE_EQ(parse_settings(words("substep_collisions 0.3")).model.substep_collisions, 0.3);
@@ -328,7 +334,7 @@ TEST(Settings, OneTableOfKeywordsInTwoTiers)
     EXPECT_FALSE(tuning_seen && k.tier == KeywordTier::user) << k.name << " after a tuning one";
     EXPECT_FALSE(k.help.empty()) << k.name;
   }
-  EXPECT_EQ(all.size(), 36u);
+  EXPECT_EQ(all.size(), 37u);
   for (const char *bad : {"tol -1", "linear_tol 0", "anderson 99", "substep_when rest"}) {
     const std::vector<std::string> w = words(bad);
     const auto k =

@@ -329,6 +329,13 @@ std::vector<Keyword> user_keywords()
          st.s.model.rows = static_cast<int>(v);
          return 2;
        }},
+      {{"contact_every", U, quoted("contact_every", "auto|<integer 1 to 1000000>"),
+        "the contacts solved every N steps, over N steps"},
+       [](const Reader &in, std::size_t i, const std::string &e, ParseState &st) -> std::size_t {
+         if (!in.has(i + 1)) Reader::illegal(e);
+         st.s.contact_every = in.at(i + 1) == "auto" ? 0 : count(in, i + 1, e, 1, 1000000);
+         return 2;
+       }},
       {{"check", U, "'check <N>' (N a non-negative integer)",
         "every N steps, the step's error against the converged step"},
        [](const Reader &in, std::size_t i, const std::string &e, ParseState &st) -> std::size_t {
@@ -652,6 +659,11 @@ std::string describe(const Settings &s)
               ? std::to_string(s.model.substeps)
               : "auto (at most " + format_g(s.model.substep_collisions) + " t_c each)");
   out += std::string(", substep_when ") + (s.model.substep_moving_only ? "moving" : "always");
+  if (s.contact_every != 1)
+    out += ", contact_every " +
+           (s.contact_every > 0
+                ? std::to_string(s.contact_every)
+                : "auto (at most " + format_g(s.model.substep_collisions) + " t_c a solve)");
   const FrictionParams &f = s.model.friction;
   return out + ", mu " + format_g(f.mu) + ", mu_roll " + format_g(f.mu_roll) + ", mu_twist " +
          format_g(f.mu_twist);

@@ -21,6 +21,10 @@ struct Settings {
   int export_every = 0; // write the step's system every N steps (0: never)
   std::string export_prefix;
   int check_every = 0; // solve the step again converged every N steps (0: never)
+  // Solve the contacts every N steps, each solve over the N steps to the next (its impulses
+  // applied at once, the external forces every step); 0: auto, the most steps within
+  // ContactModel::substep_collisions of the law's shortest collision time.
+  int contact_every = 1;
   // For the log: typed tuning keywords that have no effect under these settings, and
   // deprecated ones.
   std::vector<std::string> notes;
