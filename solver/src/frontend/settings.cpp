@@ -269,8 +269,8 @@ std::size_t read_wall_keyword(const Reader &in, std::size_t i, const std::string
   return used;
 }
 
-// The keywords a DEM deck sets.
-std::vector<Keyword> user_keywords()
+// The keywords of the contacts a DEM deck sets.
+std::vector<Keyword> contact_keywords()
 {
   const KeywordTier U = KeywordTier::user;
   const std::string substeps = "auto|<integer 1 to " + std::to_string(kMaxSubsteps) + ">";
@@ -329,6 +329,14 @@ std::vector<Keyword> user_keywords()
          st.s.model.rows = static_cast<int>(v);
          return 2;
        }},
+  };
+}
+
+// The keywords of a run: how often it solves, checks and exports, and with which solver.
+std::vector<Keyword> run_keywords()
+{
+  const KeywordTier U = KeywordTier::user;
+  return {
       {{"contact_every", U, quoted("contact_every", "auto|<integer 1 to 1000000>"),
         "the contacts solved every N steps, over N steps"},
        [](const Reader &in, std::size_t i, const std::string &e, ParseState &st) -> std::size_t {
@@ -356,6 +364,14 @@ std::vector<Keyword> user_keywords()
          return 2;
        }},
   };
+}
+
+// The keywords a DEM deck sets.
+std::vector<Keyword> user_keywords()
+{
+  std::vector<Keyword> k = contact_keywords();
+  for (Keyword &r : run_keywords()) k.push_back(std::move(r));
+  return k;
 }
 
 constexpr const char *kLinearOnly =

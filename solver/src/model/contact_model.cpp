@@ -150,6 +150,27 @@ void impact_restitution(const ContactModel &model, const PairCoefficients &pc,
   }
 }
 
+// compliance material's normal row of a contact without cohesion: its penetration and the
+// law's compliance at its overlap and last force.
+void elastic_row(const PairCoefficients &pc, const SpookParams &params, double reff, double overlap,
+                 double force, double approach, Contact &c)
+{
+  const bool known = c.penetration > 0;
+  track_penetration(params, law_overlap(pc, reff, force), overlap, approach, c);
+  // A deep new one is split (SpookParams::split_penetration) as a rigid row's is: its whole
+  // overlap, so that its spring holds no load's overlap in a cage the displacement cannot open
+  // (a sphere deposited into a bed then pushed its cage apart at 11 m/s). The spring then
+  // carries what the contact closes from there.
+  if (!known && c.penetration > params.penetration_floor * params.h * params.max_recovery)
+    c.penetration = overlap;
+  const std::array<double, kMaxRows> rigid = c.compliance;
+  // A penetration's row keeps the law's compliance at its overlap (its last force was the
+  // recovery's), so that it leaves no faster than the law's spring would push it: a soft
+  // material's overlap is removed slower than the recovery speed, as native's is.
+  material_compliance(pc, reff, overlap, c.penetration > 0 ? 0.0 : force, rigid, c.compliance,
+                      c.elastic);
+}
+
 void apply_pair(const ContactModel &model, const PairCoefficients &pc, const SpookParams &params,
                 double reff, const std::vector<Body> &bodies, double last_normal, double last_raw,
                 Contact &c)
@@ -173,20 +194,7 @@ void apply_pair(const ContactModel &model, const PairCoefficients &pc, const Spo
     const double explained = cohesive_row(pc, reff, overlap, last_raw / h, c);
     track_penetration(params, explained, overlap, normal_approach(bodies, c), c);
   } else {
-    const bool known = c.penetration > 0;
-    track_penetration(params, law_overlap(pc, reff, force), overlap, normal_approach(bodies, c), c);
-    // A deep new one is split (SpookParams::split_penetration) as a rigid row's is: its whole
-    // overlap, so that its spring holds no load's overlap in a cage the displacement cannot open
-    // (a sphere deposited into a bed then pushed its cage apart at 11 m/s). The spring then
-    // carries what the contact closes from there.
-    if (!known && c.penetration > params.penetration_floor * h * params.max_recovery)
-      c.penetration = overlap;
-    const std::array<double, kMaxRows> rigid = c.compliance;
-    // A penetration's row keeps the law's compliance at its overlap (its last force was the
-    // recovery's), so that it leaves no faster than the law's spring would push it: a soft
-    // material's overlap is removed slower than the recovery speed, as native's is.
-    material_compliance(pc, reff, overlap, c.penetration > 0 ? 0.0 : force, rigid, c.compliance,
-                        c.elastic);
+    elastic_row(pc, params, reff, overlap, force, normal_approach(bodies, c), c);
   }
   for (int r = rows; r < kMaxRows; ++r) c.elastic[r] = false;
   // A loaded contact's normal row is a Kelvin-Voigt element with the law's own dashpot (damping
