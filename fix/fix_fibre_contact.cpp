@@ -437,18 +437,16 @@ void FixFibreContact::hold_step()
     for (int i = 0; i < 6; ++i) virial[i] += held_virial_[i];
 }
 
-// The steps from this contact solve to the next (contact_every): N, or under auto the most
-// whose sum stays within kEveryCollisions of the law's shortest collision time (1 without one:
-// rigid rows). Alike on every process (m_min_ and r_min_ are global).
+// The steps from this contact solve to the next (contact_every): N, or under auto
+// fibre::steps_per_solve of the law's shortest collision time (1 without one: rigid rows). Alike on
+// every process (m_min_ and r_min_ are global).
 int FixFibreContact::solve_interval() const
 {
   if (settings_.contact_every > 0) return settings_.contact_every;
   const fibre::ContactModel &model = settings_.model;
   if (!model.compliance.material || !(m_min_ > 0 && r_min_ > 0)) return 1;
-  const double t_c = fibre::shortest_collision_time(model.materials, r_min_, m_min_, 1.0).t_c;
-  if (!(t_c > 0) || !(dtv_ > 0)) return 1;
-  const double steps = std::floor(kEveryCollisions * t_c / dtv_ * (1.0 + 1e-12));
-  return static_cast<int>(std::clamp(steps, 1.0, 1e6));
+  return fibre::steps_per_solve(
+      fibre::shortest_collision_time(model.materials, r_min_, m_min_, 1.0).t_c, dtv_);
 }
 
 // Deep penetrations: opened by a displacement that the next step's move takes, not by a

@@ -110,9 +110,6 @@ class FixFibreContact : public Fix {
   // the outputs and the global virial are the last solve's
   double h_ = 0.0;
   bigint next_solve_ = 0;
-  // contact_every auto's solve step, in collision times: LAMMPS's pour flow (shortened) keeps
-  // its kinetic energy 6.5% below native's at 0.14 t_c (every step: 5%), 13% below at 0.31 t_c
-  static constexpr double kEveryCollisions = 1.0 / 6.0;
   double held_virial_[6] = {0, 0, 0, 0, 0, 0};
   double time_origin_ = 0.0; // simulated time when the fix was defined (moving planes)
   static constexpr double kDeepOverlap = 0.05; // of the smaller diameter: warned at a run's start

@@ -197,10 +197,10 @@ std::string FixFibreContact::step_advice(double t_c) const
   const double longest = model.substep_collisions * t_c;
   if (model.substeps > 0 || settings_.contact_every != 1 || !(dtv_ < 0.5 * longest)) return "";
   const auto g = [](double x) { return fibre::format_g(x); };
-  const int every = static_cast<int>(std::floor(kEveryCollisions * t_c / dtv_ * (1.0 + 1e-12)));
+  const int every = fibre::steps_per_solve(t_c, dtv_);
   const std::string solves =
       every > 1 ? ". This deck's contacts could be solved once every " + std::to_string(every) +
-                      " steps (" + g(kEveryCollisions) +
+                      " steps (" + g(fibre::kEveryCollisions) +
                       " t_c), that many times fewer solves: give 'contact_every auto' (no other "
                       "edit). Or it"
                 : ". This deck";

@@ -1,6 +1,7 @@
 #include "fibre/frontend/settings.hpp"
 
 #include <algorithm>
+#include <cmath>
 
 #include "fibre/core/text.hpp"
 #include "fibre/step/substeps.hpp"
@@ -647,6 +648,13 @@ Settings parse_settings(const std::vector<std::string> &args)
   return s;
 }
 
+int steps_per_solve(double t_c, double dt)
+{
+  if (!(t_c > 0) || !(dt > 0)) return 1;
+  const double steps = std::floor(kEveryCollisions * t_c / dt * (1.0 + 1e-12));
+  return static_cast<int>(std::clamp(steps, 1.0, 1e6));
+}
+
 std::string describe(const Settings &s)
 {
   const ComplianceParams &c = s.model.compliance;
@@ -677,9 +685,8 @@ std::string describe(const Settings &s)
   out += std::string(", substep_when ") + (s.model.substep_moving_only ? "moving" : "always");
   if (s.contact_every != 1)
     out += ", contact_every " +
-           (s.contact_every > 0
-                ? std::to_string(s.contact_every)
-                : "auto (at most " + format_g(s.model.substep_collisions) + " t_c a solve)");
+           (s.contact_every > 0 ? std::to_string(s.contact_every)
+                                : "auto (at most " + format_g(kEveryCollisions) + " t_c a solve)");
   const FrictionParams &f = s.model.friction;
   return out + ", mu " + format_g(f.mu) + ", mu_roll " + format_g(f.mu_roll) + ", mu_twist " +
          format_g(f.mu_twist);
