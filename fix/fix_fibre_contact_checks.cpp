@@ -177,6 +177,21 @@ void FixFibreContact::check_neighbor_updates()
 void FixFibreContact::check_finite(const char *what, double **array, int nvalues) const
 {
   const int *mask = atom->mask;
+  // x * 0 is 0 for finite x and NaN otherwise: one branch-free pass (it ran nine times a
+  // step, 5% of a flow's time), and the atom named only when the sum is not 0
+  // (LAMMPS's per-atom arrays are contiguous: memory->create)
+  const int n = atom->nlocal;
+  const double *values = n > 0 ? array[0] : nullptr;
+  double sum = 0.0;
+  if (nvalues == 3) {
+    for (int i = 0; i < n; ++i) {
+      const double zero = values[3 * i] * 0.0 + values[3 * i + 1] * 0.0 + values[3 * i + 2] * 0.0;
+      sum += (mask[i] & groupbit) ? zero : 0.0;
+    }
+  } else {
+    sum = 1.0; // the naming loop below
+  }
+  if (sum == 0.0) return;
   for (int i = 0; i < atom->nlocal; ++i) {
     if (!(mask[i] & groupbit)) continue;
     for (int d = 0; d < nvalues; ++d)
