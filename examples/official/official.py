@@ -199,6 +199,21 @@ def with_drum_figures(text):
     return text + DRUM_FIGURES
 
 
+def intended_drum_deck(text):
+    """pour.drum as its comments intend, in both twins: the drum's curved wall without its top
+    cap (`open 2`: the deck adds its own top plane for the second run), so that no grain poured
+    from above enters the drum through a wall; and its delete_atoms acting on the grains above
+    half the drum's height (the dynamic group it names is evaluated every 10000 steps, so at
+    step 2000 it is still the empty group of step 0, and deletes nothing). As shipped, each
+    grain that falls into the drum through its cap is inside a wall by most of its radius, and
+    native's wall/gran/region pushes it out downwards, at twice its speed (24 to 54 m/s)."""
+    old_cap = "side in rotate v_theta ${xc} ${yc} 0 0 0 1\nregion          bottom_wall"
+    old_group = "group           delgroup dynamic all var zmax every 10000"
+    assert old_cap in text and old_group in text
+    text = text.replace(old_cap, old_cap.replace("side in", "side in open 2"))
+    return with_drum_figures(text.replace(old_group, old_group.replace("10000", "1")))
+
+
 def same(text):
     return text
 
@@ -376,6 +391,8 @@ DECKS = {
                          mixer_figures),
     "pour.drum": ("lammps", "granular/in.pour.drum", same, with_drum_figures,
                   printed_figures),
+    "pour.drum.intended": ("lammps", "granular/in.pour.drum", same, intended_drum_deck,
+                           printed_figures),
     "pour": ("lammps", "pour/in.pour", same, same, pour_figures),
     "granregion.funnel": ("lammps", "granregion/in.granregion.funnel", same, funnel_deck,
                           funnel_figures),
@@ -395,6 +412,10 @@ DECKS = {
     "chute_wear": ("liggghts", "chute_wear/in.chute_wear", same, tutorial_deck(WEAR_FIGURES),
                    wear_figures),
 }
+
+
+# decks that are another deck's conversion with other edits
+CONVERSIONS = {"pour.drum.intended": "pour.drum"}
 
 
 def host(name):
@@ -423,7 +444,7 @@ def with_keywords(text, keywords):
 def fibre_text(name, keywords=""):
     """The conversion of deck `name`, with `keywords` added to its fix fibre_contact commands
     (for example 'contact_every auto')."""
-    with open(os.path.join(HERE, "in.%s.fibre" % name)) as f:
+    with open(os.path.join(HERE, "in.%s.fibre" % CONVERSIONS.get(name, name))) as f:
         text = DECKS[name][3](f.read())
     return with_keywords(text, keywords) if keywords else text
 
