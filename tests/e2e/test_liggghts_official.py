@@ -8,7 +8,7 @@ zcylinder 0.05 0 0`.
   within 10% of native's; serial and on two processes.
 - in.cohesion (`cohesion sjkr`): every grain kept, and the cohesion holds the bed up: its
   centre at least twice as high as the cohesionless bed's (native's: 2.9 times; the fix's is
-  12.4% below native's, examples/official/README.md).
+  12.4% below native's at the deck's seed, 8.5% over five, examples/official/README.md).
 The other tutorials run shortened (official.SHORTER); in each the fix keeps every grain it
 inserts (the grains native keeps), and:
 - insert_stream (a stream falling in a box without walls; three of the four insertions): the
