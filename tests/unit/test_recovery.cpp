@@ -4,7 +4,8 @@
 // two walls has no room, and it moves no more than a step of max_recovery. Under compliance
 // material a new deep overlap is a penetration as a whole, opened as a rigid row's whatever the
 // law's softness; the spring keeps what the contact closes after it, and the history's
-// penetration shrinks by what the displacement opened.
+// penetration shrinks by what the displacement opened. A jammed row is not moved; one with room
+// opens.
 #include <gtest/gtest.h>
 
 #include <vector>
@@ -112,6 +113,41 @@ TEST(Recovery, ACagedSphereMovesNoMoreThanAStep)
   ASSERT_TRUE(recovery_displacement(sys, serial_exchange(), at_rest(bodies), sys.params().h, dx));
   EXPECT_LE(dx.head<3>().norm(), 0.005 * (1 + 1e-12));
   EXPECT_NEAR(dx[1] + dx[2], 0.0, 1e-15); // along the cage's axis only
+}
+
+// Three spheres in a row, each pair 0.1 deep, between walls (each 0.1 deep) or against the
+// left one alone.
+std::vector<Contact> row_of_three(const std::vector<Body> &bodies, bool right_wall)
+{
+  std::vector<Contact> contacts{sphere_wall_contact(bodies, 0, Vec3::UnitX(), 0.4),
+                                sphere_sphere_contact(bodies, 1, 0),
+                                sphere_sphere_contact(bodies, 2, 1)};
+  if (right_wall) contacts.push_back(sphere_wall_contact(bodies, 2, -Vec3::UnitX(), 0.4));
+  return modelled(bodies, contacts);
+}
+
+TEST(Recovery, AJammedRowIsNotMoved)
+{
+  // 2.6 between the walls for three diameters: every opening closes another contact as much
+  // (a jammed pack), and the displacement is refused
+  const std::vector<Body> bodies{sphere(0.0, 1.0), sphere(0.9, 1.0), sphere(1.8, 1.0)};
+  const ContactSystem sys(bodies, row_of_three(bodies, true), 6, params());
+  Vector dx;
+  ASSERT_TRUE(recovery_displacement(sys, serial_exchange(), at_rest(bodies), sys.params().h, dx));
+  EXPECT_EQ(dx.lpNorm<Eigen::Infinity>(), 0.0);
+}
+
+TEST(Recovery, ARowWithRoomOpens)
+{
+  // without the right wall the row slides right: every penetration opens, none closes
+  const std::vector<Body> bodies{sphere(0.0, 1.0), sphere(0.9, 1.0), sphere(1.8, 1.0)};
+  const ContactSystem sys(bodies, row_of_three(bodies, false), 6, params());
+  Vector dx;
+  ASSERT_TRUE(recovery_displacement(sys, serial_exchange(), at_rest(bodies), sys.params().h, dx));
+  EXPECT_GE(dx[0], 0.0);
+  EXPECT_GT(dx[6], dx[0]);
+  EXPECT_GT(dx[12], dx[6]);
+  EXPECT_LE(dx[12], 0.005 * (1 + 1e-12));
 }
 
 TEST(Recovery, AnElasticPenetrationOpensAsARigidRow)

@@ -54,6 +54,34 @@ std::unique_ptr<ContactSystem> rigid_rows(const ContactSystem &sys)
                                          sys.num_owned_bodies());
 }
 
+// Whether the displacement dx closes other contacts (an open one beyond its gap after the step,
+// a touching or split one at all) by at least kShuffle of what it opens of the split
+// penetrations: a jammed pack (more spheres than its box holds) has no displacement that opens
+// them, and the sweeps' unconverged impulses moved overlap from contact to contact (closed /
+// opened 0.99 to 1 a step) until the springs of the deepened contacts threw 4 of 125 spheres
+// out of the box. Where there is room the ratio is at most 0.41 (a deposit into a bed, spheres
+// created inside one). Collective.
+constexpr double kShuffle = 0.7;
+bool shuffles(const ContactSystem &sys, const Exchange &ex, const Vector &v_plus, const Vector &dx)
+{
+  const SpookParams &p = sys.params();
+  const int rows = sys.rows();
+  Vector Gv, opening;
+  g_apply(sys, v_plus, Gv);
+  g_apply(sys, dx, opening);
+  double sums[2] = {0.0, 0.0}; // opened, closed
+  for (int c = 0; c < sys.num_contacts(); ++c) {
+    const Contact &k = sys.contacts()[c];
+    const Eigen::Index row = Eigen::Index(rows) * c;
+    const bool split = p.split_penetration(k);
+    const double gap = gap_after(k, p.h, Gv[row], sys.walls_move());
+    if (split) sums[0] += std::max(opening[row], 0.0);
+    sums[1] += std::max(-opening[row] - (split ? 0.0 : std::max(gap, 0.0)), 0.0);
+  }
+  ex.sum(sums, 2);
+  return sums[1] >= kShuffle * sums[0];
+}
+
 } // namespace
 
 bool has_split_penetration(const ContactSystem &sys, const Exchange &ex)
@@ -88,6 +116,7 @@ bool recovery_displacement(const ContactSystem &sys, const Exchange &ex, const V
   }
   ex.max(&fastest, 1);
   dx *= fastest > reach ? span * reach / fastest : span;
+  if (shuffles(sys, ex, v_plus, dx)) dx.setZero(); // no room: the penetrations stay
   return true;
 }
 

@@ -24,8 +24,10 @@ bool has_split_penetration(const ContactSystem &sys, const Exchange &ex);
 // by at most span max_recovery, without closing any other contact by more than its gap: the
 // frictionless impulse problem G M^-1 G^T mu + Sigma mu = b, mu >= 0, in at most max_sweeps
 // sweeps, and each body's displacement at most span max_recovery (a cage with no room ends the
-// sweeps unconverged, with impulses that grow). span is the step the displacement is taken
-// over: the system's h, or the whole step where the system is its last substep's.
+// sweeps unconverged, with impulses that grow). A displacement that closes other contacts by
+// most of what it opens (a jammed pack, more spheres than its box holds) is not taken: dx is
+// zero, and the penetrations stay until there is room. span is the step the displacement is
+// taken over: the system's h, or the whole step where the system is its last substep's.
 // Collective; false, dx untouched, where no process has a penetration.
 bool recovery_displacement(const ContactSystem &sys, const Exchange &ex, const Vector &v_plus,
                            double span, Vector &dx, int max_sweeps = 100);
