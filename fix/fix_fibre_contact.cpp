@@ -456,6 +456,15 @@ bool FixFibreContact::recover_penetrations(fibre::Substeps &steps)
 {
   fibre::Vector dx;
   if (!fibre::recovery_displacement(steps.system, *exchange_, steps.v_plus, h_, dx)) return false;
+  // a refused displacement (recovery.hpp) is zero on every process: a jammed pack
+  if (dx.isZero(0.0) && !jammed_warned_) {
+    if (comm->me == 0)
+      warn(error, FLERR,
+           "Fix fibre_contact: penetrations have no room to open (a jammed pack: more spheres "
+           "than their walls hold, or an over-compressed packing); they stay as they are, "
+           "without load, until there is room (doc page, \"Overlaps at the start\")");
+    jammed_warned_ = true;
+  }
   fibre::take_opening(steps.system, dx, steps.springs);
   const std::vector<int> &body_atom = exchange_->body_atom();
   for (int k = 0; k < exchange_->num_owned(); ++k)

@@ -132,6 +132,7 @@ class FixFibreContact : public Fix {
   static constexpr int kPendingValues = 3;
   long overflow_count_ = 0;
   bool overflow_warned_ = false;
+  bool jammed_warned_ = false; // penetrations without room to open, warned once
 };
 
 } // namespace LAMMPS_NS
