@@ -171,6 +171,9 @@ SHORTER = {
                        ("run 15000", "run 1000")),
     # 510 grains on the chute, before any reaches its end
     "chute_wear": (("run    100000 upto", "run 40000 upto"),),
+    # the mixer: 400 grains, half the pour, 80000 steps of mixing (the blades turn 72 degrees)
+    "granregion.mixer": (("pour 1000 1 42424", "pour 400 1 42424"), ("run\t\t200000 ", "run 100000"),
+                         ("run\t\t200000", "run 80000")),
     # LAMMPS's funnel: 400 grains at four times the step (0.03 collision times, as native
     # keeps the deck's physics there), landed on the plug, then 10.5 time units of discharge
     "granregion.funnel": (("dt equal ${tcol}*0.05", "dt equal ${tcol}*0.2"),
