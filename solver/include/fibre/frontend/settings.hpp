@@ -36,8 +36,9 @@ inline constexpr double kEveryCollisions = 1.0 / 6.0;
 // A solve over several steps (contact_every) in a deck with moving walls is split in substeps
 // of at most this many collision times: in one of t_c / 6, LAMMPS's mixer threw grains off its
 // blades to a height of 15.7 +- 3.3 over five seeds (native 11.5 +- 0.7), in two of t_c / 12
-// still to 17.8 and 18.6 in two seeds, in four of t_c / 24 to 11.1 +- 0.5, at 27% more time
-// than one. Without moving walls, substeps left the pour's flow as it was.
+// still to 17.8 and 18.6 in two seeds, in four of t_c / 24 (from the first solve that met a
+// blade) to 10.6 +- 1.6, at 20% more time than one. Without moving walls, substeps left the
+// pour's flow as it was.
 inline constexpr double kEveryMovingCollisions = 1.0 / 24.0;
 
 // contact_every auto's steps a solve at step dt: the most whose sum is at most
