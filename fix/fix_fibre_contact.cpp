@@ -580,8 +580,10 @@ void FixFibreContact::final_integrate()
   fibre::FoundContacts found =
       detection_->contacts(bodies, h_, model.damping, model.may_bounce() || substeps > 1,
                            reach ? hs * recovery : 0.0, recovering_);
-  substeps = moving_wall_substeps(substeps, found.contacts);
-  hs = h_ / substeps;
+  if (note_moving_walls(found.contacts)) {
+    substeps = step_substeps();
+    hs = h_ / substeps;
+  }
   if (first_step_) warn_deep_overlaps(bodies, found.contacts, recovery);
   warn_skin();
   first_step_ = false;

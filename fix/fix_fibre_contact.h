@@ -80,7 +80,7 @@ class FixFibreContact : public Fix {
   void follow_substeps(const fibre::Vector &path, int n, double hs);
   bool recover_penetrations(fibre::Substeps &steps);
   int step_substeps();
-  int moving_wall_substeps(int substeps, const std::vector<fibre::Contact> &contacts);
+  bool note_moving_walls(const std::vector<fibre::Contact> &contacts);
   std::string step_advice(double t_c) const;
   double simulated_time() const;
   void tally_wall_loads(const fibre::ContactSystem &sys, const std::vector<fibre::ContactTag> &tags,
@@ -133,9 +133,8 @@ class FixFibreContact : public Fix {
   static constexpr int kPendingValues = 3;
   long overflow_count_ = 0;
   bool overflow_warned_ = false;
-  bool jammed_warned_ = false; // penetrations without room to open, warned once
-  bool moving_substeps_logged_ = false;
-  bool moving_walls_met_ = false; // a solve met a moving wall (moving_wall_substeps)
+  bool jammed_warned_ = false;    // penetrations without room to open, warned once
+  bool moving_walls_met_ = false; // a solve over several steps met a moving wall
 };
 
 } // namespace LAMMPS_NS

@@ -15,12 +15,11 @@ namespace {
 // The target opening speed of each normal row: a penetration's overlap left after the step (a
 // rigid row's whole overlap, an elastic row's penetration as far as the overlap still holds
 // it), at most max_recovery; an open contact may close by its gap; a touching one not further.
-Vector recovery_rhs(const ContactSystem &sys, const Vector &v_plus, double span)
+// (Gv: G v_plus, the velocities after the step)
+Vector recovery_rhs(const ContactSystem &sys, const Vector &Gv, double span)
 {
   const SpookParams &p = sys.params();
   const int rows = sys.rows();
-  Vector Gv;
-  g_apply(sys, v_plus, Gv);
   Vector b = Vector::Zero(sys.contact_dofs());
   for (int c = 0; c < sys.num_contacts(); ++c) {
     const Contact &k = sys.contacts()[c];
@@ -62,12 +61,11 @@ std::unique_ptr<ContactSystem> rigid_rows(const ContactSystem &sys)
 // out of the box. Where there is room the ratio is at most 0.41 (a deposit into a bed, spheres
 // created inside one). Collective.
 constexpr double kShuffle = 0.7;
-bool shuffles(const ContactSystem &sys, const Exchange &ex, const Vector &v_plus, const Vector &dx)
+bool shuffles(const ContactSystem &sys, const Exchange &ex, const Vector &Gv, const Vector &dx)
 {
   const SpookParams &p = sys.params();
   const int rows = sys.rows();
-  Vector Gv, opening;
-  g_apply(sys, v_plus, Gv);
+  Vector opening;
   g_apply(sys, dx, opening);
   double sums[2] = {0.0, 0.0}; // opened, closed
   for (int c = 0; c < sys.num_contacts(); ++c) {
@@ -100,7 +98,9 @@ bool recovery_displacement(const ContactSystem &sys, const Exchange &ex, const V
   const std::unique_ptr<ContactSystem> rigid = rigid_rows(sys);
   const ContactSystem &solved = rigid ? *rigid : sys;
   const Cones frictionless = Cones::frictionless(solved);
-  const Vector b = recovery_rhs(sys, v_plus, span);
+  Vector Gv;
+  g_apply(sys, v_plus, Gv);
+  const Vector b = recovery_rhs(sys, Gv, span);
   Vector mu = Vector::Zero(sys.contact_dofs());
   PgsControl control;
   control.max_sweeps = max_sweeps;
@@ -116,7 +116,7 @@ bool recovery_displacement(const ContactSystem &sys, const Exchange &ex, const V
   }
   ex.max(&fastest, 1);
   dx *= fastest > reach ? span * reach / fastest : span;
-  if (shuffles(sys, ex, v_plus, dx)) dx.setZero(); // no room: the penetrations stay
+  if (shuffles(sys, ex, Gv, dx)) dx.setZero(); // no room: the penetrations stay
   return true;
 }
 

@@ -7,11 +7,11 @@
 
 namespace fibre {
 
-int substeps_for(const ContactModel &model, double h, double t_c)
+int substeps_for(const ContactModel &model, double h, double t_c, double cap)
 {
   if (model.substeps > 0) return model.substeps;
   if (!(t_c > 0) || !(h > 0)) return 1;
-  const double n = std::ceil(h / (model.substep_collisions * t_c) - 1e-9);
+  const double n = std::ceil(h / (std::min(model.substep_collisions, cap) * t_c) - 1e-9);
   return static_cast<int>(std::clamp(n, 1.0, double(kMaxSubsteps)));
 }
 

@@ -12,16 +12,19 @@
 
 #include "fibre/algebra/spook.hpp"
 #include "fibre/core/exchange.hpp"
+#include <cmath>
+
 #include "fibre/model/contact_model.hpp"
 #include "fibre/step/step_solver.hpp"
 
 namespace fibre {
 
 // The substeps of a step h: ContactModel::substeps where it is typed (> 0), else (automatic)
-// the fewest whose length is at most substep_collisions times t_c, the shortest collision time
-// of the material's type pairs (t_c <= 0: no elastic law, one substep), at most kMaxSubsteps.
+// the fewest whose length is at most substep_collisions (and at most `cap`) times t_c, the
+// shortest collision time of the material's type pairs (t_c <= 0: no elastic law, one
+// substep), at most kMaxSubsteps.
 inline constexpr int kMaxSubsteps = 1000;
-int substeps_for(const ContactModel &model, double h, double t_c);
+int substeps_for(const ContactModel &model, double h, double t_c, double cap = INFINITY);
 
 // Whether some contact moves within the step (step.h, SPOOK's damping step.damping): its
 // surfaces slide, roll, press or part at more than `speed` where they touch or will within the
