@@ -244,14 +244,6 @@ void FixFibreContact::init()
 {
   if (starts_with(update->integrate_style, "respa"))
     fail(error, FLERR, "Fix fibre_contact does not support run_style respa");
-#ifndef FIBRE_HOST_LIGGGHTS
-  // The halo's reverse sum is LAMMPS's variable-size reverse comm (fix/lammps_compat.h), which
-  // LAMMPS 29 Sep 2021 has for comm_style brick only.
-  if (comm->style != 0)
-    fail(error, FLERR,
-         "Fix fibre_contact requires comm_style brick (this LAMMPS has no "
-         "variable-size reverse communication for comm_style tiled)");
-#endif
   check_pair_style(true);
   dtv_ = update->dt;
   warn_double_integration();

@@ -14,8 +14,6 @@
 
 namespace fibre_lmp {
 
-namespace {
-
 // The sweeps' halo (fibre::Exchange::Halo) by MPI point to point, on the bodies that contacts
 // move. LAMMPS's forward and reverse comms carry 6 values for every ghost atom through every
 // swap; a sweep on a stiff pile needs only the few dozen bodies that straddle a boundary, and
@@ -44,6 +42,17 @@ class PointHalo final : public fibre::Exchange::Halo {
   int colours() const override { return colours_; }
   int colour() const override { return colour_; }
   const std::vector<int> *bodies() const override { return &bodies_; }
+
+  // The ghosts' values added into their owners' (images' into their bodies'), the ghosts' and
+  // images' then zero: Exchange::reverse_sum where every ghost body is in the links.
+  void reverse_sum(fibre::Vector &v) const
+  {
+    move(v, ghosts_, shared_, true, kChanges);
+    for (const auto &[image, body] : images_) v.segment<6>(6 * body) += v.segment<6>(6 * image);
+    for (const Link &l : ghosts_)
+      for (const int b : l.bodies) v.segment<6>(6 * b).setZero();
+    for (const auto &[image, body] : images_) v.segment<6>(6 * image).setZero();
+  }
 
   void sum_copies(fibre::Vector &v) const override
   {
@@ -108,6 +117,8 @@ class PointHalo final : public fibre::Exchange::Halo {
   mutable std::vector<MPI_Request> requests_;
 };
 
+namespace {
+
 // Two colours for the processes (Exchange::Halo::colours), the same on every one: each owner
 // lists, per pair of processes that touch one of its bodies, how many such bodies; the lists
 // are gathered, and each process in rank order takes the colour whose processes of lower rank
@@ -148,6 +159,7 @@ LammpsExchange::LammpsExchange(LAMMPS_NS::LAMMPS *lmp, LAMMPS_NS::Fix *fix, MPI_
 
 LammpsExchange::~LammpsExchange()
 {
+  every_ghost_.reset();
   if (halo_comm_ != MPI_COMM_NULL) MPI_Comm_free(&halo_comm_);
 }
 
@@ -200,6 +212,12 @@ std::vector<int> process_edges(const std::vector<char> &touched,
 
 std::unique_ptr<fibre::Exchange::Halo> LammpsExchange::halo(const std::vector<char> &touched,
                                                             bool colour) const
+{
+  return point_halo(touched, colour);
+}
+
+std::unique_ptr<PointHalo> LammpsExchange::point_halo(const std::vector<char> &touched,
+                                                      bool colour) const
 {
   using Link = PointHalo::Link;
   const int nprocs = lmp_->comm->nprocs, me = lmp_->comm->me;
@@ -279,6 +297,16 @@ void LammpsExchange::set_bodies(const std::vector<int> &body_atom, int num_owned
   }
   has_halo_ = lmp_->comm->nprocs > 1 || body_atom.size() > std::size_t(num_owned);
   ghost_owners_known_ = false;
+  every_ghost_.reset();
+}
+
+bool LammpsExchange::comm_tiled() const
+{
+#ifdef FIBRE_HOST_LIGGGHTS
+  return false;
+#else
+  return lmp_->comm->style != 0;
+#endif
 }
 
 void LammpsExchange::resize_halo() const
@@ -306,6 +334,13 @@ void LammpsExchange::forward(fibre::Vector &body_vec) const
 void LammpsExchange::reverse_sum(fibre::Vector &body_vec) const
 {
   if (!has_halo_) return;
+  if (comm_tiled()) {
+    // LAMMPS 29 Sep 2021's CommTiled has no variable-size reverse comm: point to point over
+    // every ghost body, the sweeps' halo with all of them touched.
+    if (!every_ghost_) every_ghost_ = point_halo(std::vector<char>(body_atom_.size(), 1), false);
+    every_ghost_->reverse_sum(body_vec);
+    return;
+  }
   resize_halo();
   const std::size_t nall = std::size_t(lmp_->atom->nlocal + lmp_->atom->nghost);
   std::fill(halo_.begin(), halo_.begin() + kValuesPerAtom * nall, 0.0);

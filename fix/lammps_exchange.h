@@ -4,11 +4,13 @@
 // Bodies are atoms: body k of the contact system is local atom body_atom[k], owned bodies
 // first, then ghosts. forward() and reverse_sum() move 6 doubles per atom through the fix's
 // pack/unpack_forward_comm and pack/unpack_reverse_comm (comm_forward = comm_reverse = 6);
-// the global reductions use MPI on the fix's world communicator.
+// under comm_style tiled reverse_sum() goes point to point to the ghosts' owners instead. The
+// global reductions use MPI on the fix's world communicator.
 #pragma once
 
 #include <mpi.h>
 
+#include <memory>
 #include <unordered_map>
 #include <vector>
 
@@ -21,6 +23,8 @@ class Fix;
 } // namespace LAMMPS_NS
 
 namespace fibre_lmp {
+
+class PointHalo;
 
 class LammpsExchange final : public fibre::Exchange {
  public:
@@ -56,6 +60,8 @@ class LammpsExchange final : public fibre::Exchange {
 
  private:
   void resize_halo() const;
+  std::unique_ptr<PointHalo> point_halo(const std::vector<char> &touched, bool colour) const;
+  bool comm_tiled() const;
   // The owner process of every ghost body (-1 for owned ones), by a forward comm once per set
   // of bodies.
   const std::vector<int> &ghost_owners() const;
@@ -72,6 +78,8 @@ class LammpsExchange final : public fibre::Exchange {
   MPI_Comm halo_comm_ = MPI_COMM_NULL; // the sweeps' messages, apart from LAMMPS's
   bool has_halo_ = true;               // other processes, or ghost bodies here
   mutable std::vector<double> halo_;   // 6 per local atom (owned + ghost)
+  // comm_style tiled's reverse sum: every ghost body's link to its owner, once per set of bodies
+  mutable std::unique_ptr<PointHalo> every_ghost_;
 };
 
 } // namespace fibre_lmp

@@ -132,7 +132,6 @@ CASES = [
     ("varshape_region", "wall region ball", "a region whose shape changes over time",
      {"pre": "variable rad equal 2.0+0.1*time\nregion ball sphere 0 0 2 v_rad side in units box"}),
     ("two_d", "", "requires a 3d simulation", {"deck": TWO_D}),
-    ("comm_tiled", "", "requires comm_style brick", {"pre": "comm_style tiled"}),
     ("infinite_force", "", "non-finite force of atom 1 at step 1",
      {"pre": "fix push all addforce 0 0 1e400"}),
     ("infinite_velocity", "", "non-finite velocity of atom 1 at step 1",
