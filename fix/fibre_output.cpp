@@ -103,7 +103,7 @@ void FibreOutput::fill_local(const std::vector<fibre::ContactTag> &tags,
 {
   const int nc = static_cast<int>(tags.size());
   if (nc > maxlocal_) {
-    maxlocal_ = std::max(nc, 2 * maxlocal_);
+    maxlocal_ = nc;
     memory->destroy(local_array_);
     memory->create(local_array_, maxlocal_, kLocalColumns, "fibre_contact:local");
   }
@@ -127,6 +127,15 @@ void FibreOutput::fill_local(const std::vector<fibre::ContactTag> &tags,
       row[7] = std::fabs(l[3]);
     }
   }
+}
+
+void FibreOutput::release_local(double **&array_local, int &size_local_rows)
+{
+  memory->destroy(local_array_);
+  local_array_ = nullptr;
+  maxlocal_ = 0;
+  array_local = nullptr;
+  size_local_rows = 0;
 }
 
 void FibreOutput::export_step(const std::string &prefix, const fibre::ContactSystem &sys,

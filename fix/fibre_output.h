@@ -77,6 +77,9 @@ class FibreOutput : protected LAMMPS_NS::Pointers {
   // One row per contact: tags, wall, gap, |normal|, |friction|, |rolling|, |twisting| impulse.
   void fill_local(const std::vector<fibre::ContactTag> &tags, const fibre::Vector *lambda, int rows,
                   double **&array_local, int &size_local_rows);
+  // Frees the rows before a solve, which has no use for them (fill_local makes them again,
+  // as many as the contacts): the solve's peak memory holds no copy of the last step's.
+  void release_local(double **&array_local, int &size_local_rows);
   // prefix.STEP.RANK.sys (the system) and .lambda (the atoms of every contact, its impulses and
   // the warm start the solve began from): together the whole step, to replay it; and .images
   // (image body, per line) where ghosts are periodic images of this process's bodies (owners:

@@ -552,6 +552,7 @@ void FixFibreContact::final_integrate()
     hold_step();
     return;
   }
+  output_->release_local(array_local, size_local_rows);
   const fibre::ContactModel &model = settings_.model;
   std::vector<fibre::Body> bodies = detection_->bodies();
   detection_->set_wall_time(simulated_time() - time_origin_);

@@ -115,7 +115,6 @@ void ContactSystem::compute_derived()
     inv_mass_.segment<3>(6 * i).setConstant(1.0 / b.mass);
     inv_mass_.segment<3>(6 * i + 3).setConstant(1.0 / inertia);
   }
-  mass_ = inv_mass_.cwiseInverse();
   external_dv_.resize(Eigen::Index(kBodyDofs) * nb);
   for (int i = 0; i < nb; ++i) {
     external_dv_.segment<3>(6 * i) = params_.h * bodies_[i].force;

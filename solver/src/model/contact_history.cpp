@@ -41,7 +41,7 @@ int ContactHistory::unpack(int i, const double *buf, int available, int slot_siz
 double ContactHistory::memory_bytes() const
 {
   return double(count_.capacity()) * sizeof(int) + double(first_.capacity()) * sizeof(std::size_t) +
-         double(pool_.capacity() + spare_.capacity()) * sizeof(double);
+         double(pool_.capacity()) * sizeof(double);
 }
 
 const double *ContactHistory::find(int atom, double key) const
@@ -165,16 +165,16 @@ long ContactHistory::store(const std::vector<ContactTag> &tags,
     first_[i] = total;
     total += count_[i];
   }
-  spare_.resize(total * kSlotSize);
+  std::vector<double> pool(total * kSlotSize);
   std::vector<int> filled(count_.size(), 0);
   for (int c = 0; c < nc; ++c) {
     if (!kept[c]) continue;
     const int s = tags[c].store;
-    double *slot = spare_.data() + (first_[s] + filled[s]++) * kSlotSize;
+    double *slot = pool.data() + (first_[s] + filled[s]++) * kSlotSize;
     write_slot(slot, tags[c].key, contacts[c], lambda.data() + Eigen::Index(rows) * c, rows, h,
                springs ? &(*springs)[c] : nullptr);
   }
-  pool_.swap(spare_);
+  pool_ = std::move(pool); // the old pool freed: no second one held through the next solve
   return overflow;
 }
 

@@ -85,12 +85,20 @@ enum : int {
   kRhs = 15,  // b, Sigma and 1 / scale: 6 rows each (3 used with rows 3)
   kSigma = 21,
   kScale = 27,
-  kMassA = 33, // the bodies' inverse masses (zero for a wall's side and an empty lane)
-  kMassB = 39,
-  kCoeff = 45, // the cones' coefficients
-  kPull = 48,  // h times the pull-off force (Cones::pull)
-  kFields = 49
+  kMassA = 33, // the bodies' inverse mass and inertia (zero for a wall's side and an empty
+  kMassB = 35, // lane): a sphere's three of each are one number
+  kCoeff = 37, // the cones' coefficients
+  kPull = 40,  // h times the pull-off force (Cones::pull)
+  kFields = 41
 };
+
+// A body's three inverse masses (or inertias), which the groups pack as one.
+double isotropic(const double *m)
+{
+  if ((m[1] != m[0] || m[2] != m[0]) && !std::isnan(m[0]))
+    throw std::logic_error("GroupedSweep: a body's inverse masses differ by axis");
+  return m[0];
+}
 
 } // namespace
 
@@ -119,9 +127,9 @@ GroupedSweep::GroupedSweep(const ContactSystem &sys, const Cones &cones, const V
     const auto put = [p](int field, double value) { p[kGroupLanes * field] = value; };
     const double *q = sys.kinematics(c).frame.data();
     for (int f = 0; f < 15; ++f) put(kFrame + f, q[f]);
-    for (int d = 0; d < 6; ++d) {
-      put(kMassA + d, inv_mass[6 * std::size_t(a) + d]);
-      put(kMassB + d, bb >= 0 ? inv_mass[6 * std::size_t(bb) + d] : 0.0);
+    for (int d = 0; d < 2; ++d) {
+      put(kMassA + d, isotropic(inv_mass + 6 * std::size_t(a) + 3 * d));
+      put(kMassB + d, bb >= 0 ? isotropic(inv_mass + 6 * std::size_t(bb) + 3 * d) : 0.0);
     }
   }
   refresh(sys, cones, b, inv_scale);
@@ -309,8 +317,8 @@ FIBRE_AVX2 void add_change(const double *p, const __m256d D[9], const __m256d ra
   body_impulse(ra, f, m, ya);
   body_impulse(rb, f, m, yb);
   for (int d = 0; d < 6; ++d) {
-    va[d] = _mm256_fmadd_pd(_mm256_loadu_pd(p + kGroupLanes * (kMassA + d)), ya[d], va[d]);
-    vb[d] = _mm256_fnmadd_pd(_mm256_loadu_pd(p + kGroupLanes * (kMassB + d)), yb[d], vb[d]);
+    va[d] = _mm256_fmadd_pd(_mm256_loadu_pd(p + kGroupLanes * (kMassA + d / 3)), ya[d], va[d]);
+    vb[d] = _mm256_fnmadd_pd(_mm256_loadu_pd(p + kGroupLanes * (kMassB + d / 3)), yb[d], vb[d]);
   }
 }
 

@@ -280,7 +280,8 @@ class ContactSystem {
   const Vector &inv_mass() const { return inv_mass_; } // diagonal of M^-1, 6 per body
   // h M^-1 (force, torque) of every body: the external forces' velocity change in a step.
   const Vector &external_velocity_change() const { return external_dv_; }
-  const Vector &mass() const { return mass_; }   // diagonal of M, 6 per body
+  // diagonal of M, 6 per body: an expression of inv_mass (1 / x), not a second vector
+  auto mass() const { return inv_mass_.cwiseInverse(); }
   const Vector &sigma() const { return sigma_; } // diagonal of Sigma, rows per contact
   const Vector &rhs() const { return rhs_; }
   void set_rhs(const Vector &b) { rhs_ = b; }
@@ -335,7 +336,6 @@ class ContactSystem {
   bool walls_move_ = false;
   std::vector<unsigned char> mask_; // empty = all rows active
   Vector inv_mass_;
-  Vector mass_;
   Vector external_dv_;
   Vector sigma_;
   Vector inv_sigma_;

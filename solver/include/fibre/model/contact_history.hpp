@@ -62,12 +62,12 @@ class ContactHistory {
   const double *slots(int atom) const { return pool_.data() + first_[atom] * kSlotSize; }
   // Atom i's count_[i] slots start at slot first_[i] of pool_: the pool holds the stored
   // contacts and no more (a layout per atom sized to the most contacts on one atom was 8 slots
-  // for each of LAMMPS's atom places, 40% of bench/scale's heap). store() rebuilds the pool
-  // in spare_ and swaps; unpack appends; copy shares an atom's slots, which are never written
+  // for each of LAMMPS's atom places, 40% of bench/scale's heap). store() builds a new pool
+  // and frees the old; unpack appends; copy shares an atom's slots, which are never written
   // in place.
   std::vector<int> count_;
   std::vector<std::size_t> first_;
-  std::vector<double> pool_, spare_;
+  std::vector<double> pool_;
 };
 
 } // namespace fibre
