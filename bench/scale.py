@@ -1,7 +1,9 @@
 #!/usr/bin/env python3
 """The scale benchmark: fix fibre_contact against native LAMMPS on a dense bed that grows
 (bench/scale/in.bed: D fcc cells deep, W across, N = 4 W^2 D spheres settling for tend
-simulated seconds), both twins of one size and process count run back to back.
+simulated seconds), both twins of one size and process count run back to back: the fix at its
+default step 0.002 s, native at t_c / 20 (the Hertz collision time of the smallest spheres at
+1 m/s), the step at which its bed agrees with a step 90 times smaller.
 
 For each run: wall seconds per simulated second, the largest resident set of any process
 (GNU time), bytes per sphere and per contact above the same method's run of 16 spheres (of the
@@ -12,10 +14,12 @@ last step, and with --check its last check's velocity error against the converge
 speed ratio is native's wall time over the fix's for the same simulated time.
 
   python3 bench/scale.py [--lmp build/fix/lmp_fibre] [--N 10000 100000] [--np 1 2]
-                         [--depth 10] [--tend 0.5] [--check] [--workdir W] [--methods ...]
+                         [--depth 10] [--tend 0.5] [--E 1e7] [--check] [--workdir W]
+                         [--methods ...]
 """
 
 import argparse
+import math
 import os
 import re
 import subprocess
@@ -27,7 +31,22 @@ sys.path.insert(0, os.path.join(HERE, "..", "tools"))
 from lammps_runs import lmp_env, mpi_prefix, parse_thermo  # noqa: E402
 
 
-def run(lmp, np, method, W, D, tend, check, workdir):
+def collision_time(E, nu=0.3, r=0.45, density=2500.0, v=1.0):
+    """The Hertz collision time of two of the bed's smallest spheres meeting at v, as the fix
+    logs it (LAMMPS's hertz/material: k_n = 4/3 E / (2 (1 - nu^2)))."""
+    m = density * 4.0 / 3.0 * math.pi * r ** 3
+    K = 4.0 / 3.0 * E / (2.0 * (1.0 - nu * nu)) * math.sqrt(0.5 * r)
+    d_max = (1.25 * 0.5 * m * v * v / K) ** 0.4
+    half = 0.4 * math.gamma(0.4) * math.gamma(0.5) / math.gamma(0.9)
+    return 2.0 * half * d_max / v
+
+
+def native_step(E):
+    """Native's step: t_c / 20 at 1 m/s, the examples' rule (examples/README.md)."""
+    return collision_time(E) / 20.0
+
+
+def run(lmp, np, method, W, D, tend, check, workdir, E=1e7):
     """One run; its figures (a dict) or None where it failed."""
     os.makedirs(workdir, exist_ok=True)
     log = os.path.join(workdir, "log.%s.W%d.np%d" % (method, W, np))
@@ -35,7 +54,8 @@ def run(lmp, np, method, W, D, tend, check, workdir):
     cmd = mpi_prefix("mpirun", np) + [
         "/usr/bin/time", "-f", "MAXRSS %M", lmp, "-in", os.path.join(HERE, "scale", "in.bed"),
         "-log", log, "-echo", "none", "-var", "W", str(W), "-var", "D", str(D),
-        "-var", "method", method, "-var", "tend", str(tend),
+        "-var", "method", method, "-var", "tend", str(tend), "-var", "E", "%g" % E,
+        "-var", "dt_native", "%.3g" % native_step(E),
         "-var", "check", str(steps if check else 0)]
     t0 = time.time()
     proc = subprocess.run(cmd, cwd=workdir, stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
@@ -73,11 +93,14 @@ def main():
     p.add_argument("--np", type=int, nargs="+", default=[1, 2])
     p.add_argument("--depth", type=int, default=10)
     p.add_argument("--tend", type=float, default=0.5)
+    p.add_argument("--E", type=float, default=1e7, help="Young's modulus, spheres and walls")
     p.add_argument("--check", action="store_true", help="check the last step of the fix")
     p.add_argument("--methods", nargs="+", default=["fibre", "native"])
     p.add_argument("--workdir", default="scale-runs")
     a = p.parse_args()
     lmp = os.path.abspath(a.lmp)
+    print("E %g: the fix at 0.002 s, native at t_c / 20 = %.3g s (t_c %.3g s at 1 m/s)"
+          % (a.E, native_step(a.E), collision_time(a.E)))
     print("| N | np | contacts | fix s / sim s | native s / sim s | native / fix speed | "
           "RSS fix | RSS native | fix bytes / sphere, / contact | "
           "native bytes / sphere, / contact | "
@@ -87,13 +110,14 @@ def main():
     for np in a.np:
         for m in a.methods:
             small = run(lmp, np, m, 2, 1, 0.01, False,
-                        os.path.join(os.path.abspath(a.workdir), "base"))
+                        os.path.join(os.path.abspath(a.workdir), "base"), a.E)
             base[m, np] = small["rss"] if small else 0
     for n in a.N:
         W = max(2, round((n / (4.0 * a.depth)) ** 0.5))
         for np in a.np:
             figs = {m: run(lmp, np, m, W, a.depth, a.tend, a.check,
-                           os.path.join(os.path.abspath(a.workdir), "W%d" % W)) for m in a.methods}
+                           os.path.join(os.path.abspath(a.workdir), "W%d" % W), a.E)
+                    for m in a.methods}
             for m, d in figs.items():
                 if d:
                     # the largest process's: its share of the spheres and contacts

@@ -286,16 +286,18 @@ void LammpsExchange::set_bodies(const std::vector<int> &body_atom, int num_owned
 {
   body_atom_ = body_atom;
   num_owned_ = num_owned;
-  // a ghost with the tag of an owned body is its periodic image on this process
+  has_halo_ = lmp_->comm->nprocs > 1 || body_atom.size() > std::size_t(num_owned);
+  // a ghost with the tag of an owned body is its periodic image on this process; without
+  // ghosts and other processes no tag is looked up (the map took 33 bytes a sphere)
   const LAMMPS_NS::tagint *tag = lmp_->atom->tag;
-  owned_body_.clear();
-  for (int k = 0; k < num_owned; ++k) owned_body_.emplace(tag[body_atom[k]], k);
+  std::unordered_map<LAMMPS_NS::tagint, int>().swap(owned_body_);
+  if (has_halo_)
+    for (int k = 0; k < num_owned; ++k) owned_body_.emplace(tag[body_atom[k]], k);
   local_owners_.resize(body_atom.size());
   for (int k = 0; k < static_cast<int>(body_atom.size()); ++k) {
     const auto it = k < num_owned ? owned_body_.end() : owned_body_.find(tag[body_atom[k]]);
     local_owners_[k] = it == owned_body_.end() ? k : it->second;
   }
-  has_halo_ = lmp_->comm->nprocs > 1 || body_atom.size() > std::size_t(num_owned);
   ghost_owners_known_ = false;
   every_ghost_.reset();
 }
