@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """The scale benchmark: fix fibre_contact against native LAMMPS on a dense bed that grows
 (bench/scale/in.bed: D fcc cells deep, W across, N = 4 W^2 D spheres settling for tend
-simulated seconds), both twins of one size and process count run back to back: the fix at its
+simulated seconds; growing in width at a fixed depth, or with --width in depth), both twins of one size and process count run back to back: the fix at its
 default step 0.002 s, native at t_c / 20 (the Hertz collision time of the smallest spheres at
 1 m/s), the step at which its bed agrees with a step 90 times smaller.
 
@@ -14,7 +14,7 @@ last step, and with --check its last check's velocity error against the converge
 speed ratio is native's wall time over the fix's for the same simulated time.
 
   python3 bench/scale.py [--lmp build/fix/lmp_fibre] [--N 10000 100000] [--np 1 2]
-                         [--depth 10] [--tend 0.5] [--E 1e7] [--check] [--workdir W]
+                         [--depth 10 | --width W] [--tend 0.5] [--E 1e7] [--check] [--workdir W]
                          [--methods ...]
 """
 
@@ -92,6 +92,8 @@ def main():
     p.add_argument("--N", type=int, nargs="+", default=[10000, 100000])
     p.add_argument("--np", type=int, nargs="+", default=[1, 2])
     p.add_argument("--depth", type=int, default=10)
+    p.add_argument("--width", type=int, default=0,
+                   help="fcc cells across, fixed: the bed grows in depth (0: it grows in width)")
     p.add_argument("--tend", type=float, default=0.5)
     p.add_argument("--E", type=float, default=1e7, help="Young's modulus, spheres and walls")
     p.add_argument("--check", action="store_true", help="check the last step of the fix")
@@ -113,10 +115,13 @@ def main():
                         os.path.join(os.path.abspath(a.workdir), "base"), a.E)
             base[m, np] = small["rss"] if small else 0
     for n in a.N:
-        W = max(2, round((n / (4.0 * a.depth)) ** 0.5))
+        if a.width:
+            W, D = a.width, max(1, round(n / (4.0 * a.width ** 2)))
+        else:
+            W, D = max(2, round((n / (4.0 * a.depth)) ** 0.5)), a.depth
         for np in a.np:
-            figs = {m: run(lmp, np, m, W, a.depth, a.tend, a.check,
-                           os.path.join(os.path.abspath(a.workdir), "W%d" % W), a.E)
+            figs = {m: run(lmp, np, m, W, D, a.tend, a.check,
+                           os.path.join(os.path.abspath(a.workdir), "W%dD%d" % (W, D)), a.E)
                     for m in a.methods}
             for m, d in figs.items():
                 if d:
