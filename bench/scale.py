@@ -14,7 +14,8 @@ last step, and with --check its last check's velocity error against the converge
 speed ratio is native's wall time over the fix's for the same simulated time.
 
   python3 bench/scale.py [--lmp build/fix/lmp_fibre] [--N 10000 100000] [--np 1 2]
-                         [--depth 10 | --width W] [--tend 0.5] [--E 1e7] [--check] [--workdir W]
+                         [--depth 10 | --width W] [--tend 0.5] [--E 1e7] [--L 1] [--dt-fibre 0.002]
+                         [--keywords "..."] [--check] [--workdir W]
                          [--methods ...]
 """
 
@@ -31,9 +32,10 @@ sys.path.insert(0, os.path.join(HERE, "..", "tools"))
 from lammps_runs import lmp_env, mpi_prefix, parse_thermo  # noqa: E402
 
 
-def collision_time(E, nu=0.3, r=0.45, density=2500.0, v=1.0):
-    """The Hertz collision time of two of the bed's smallest spheres meeting at v, as the fix
-    logs it (LAMMPS's hertz/material: k_n = 4/3 E / (2 (1 - nu^2)))."""
+def collision_time(E, L=1.0, nu=0.3, density=2500.0, v=1.0):
+    """The Hertz collision time of two of the bed's smallest spheres (radius 0.45 L) meeting at
+    v, as the fix logs it (LAMMPS's hertz/material: k_n = 4/3 E / (2 (1 - nu^2)))."""
+    r = 0.45 * L
     m = density * 4.0 / 3.0 * math.pi * r ** 3
     K = 4.0 / 3.0 * E / (2.0 * (1.0 - nu * nu)) * math.sqrt(0.5 * r)
     d_max = (1.25 * 0.5 * m * v * v / K) ** 0.4
@@ -41,21 +43,22 @@ def collision_time(E, nu=0.3, r=0.45, density=2500.0, v=1.0):
     return 2.0 * half * d_max / v
 
 
-def native_step(E):
-    """Native's step: t_c / 20 at 1 m/s, the examples' rule (examples/README.md)."""
-    return collision_time(E) / 20.0
+def native_step(E, L=1.0):
+    """Native's step: t_c / 20 at 1 m/s."""
+    return collision_time(E, L) / 20.0
 
 
-def run(lmp, np, method, W, D, tend, check, workdir, E=1e7):
+def run(lmp, np, method, W, D, tend, check, workdir, E=1e7, L=1.0, dt_fibre=0.002, keywords=""):
     """One run; its figures (a dict) or None where it failed."""
     os.makedirs(workdir, exist_ok=True)
     log = os.path.join(workdir, "log.%s.W%d.np%d" % (method, W, np))
-    steps = round(tend / 0.002)
+    steps = round(tend / dt_fibre)
     cmd = mpi_prefix("mpirun", np) + [
         "/usr/bin/time", "-f", "MAXRSS %M", lmp, "-in", os.path.join(HERE, "scale", "in.bed"),
         "-log", log, "-echo", "none", "-var", "W", str(W), "-var", "D", str(D),
         "-var", "method", method, "-var", "tend", str(tend), "-var", "E", "%g" % E,
-        "-var", "dt_native", "%.3g" % native_step(E),
+        "-var", "L", "%g" % L, "-var", "dt_fibre", "%g" % dt_fibre, "-var", "fc_extra", keywords,
+        "-var", "dt_native", "%.3g" % native_step(E, L),
         "-var", "check", str(steps if check else 0)]
     t0 = time.time()
     proc = subprocess.run(cmd, cwd=workdir, stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
@@ -96,13 +99,19 @@ def main():
                    help="fcc cells across, fixed: the bed grows in depth (0: it grows in width)")
     p.add_argument("--tend", type=float, default=0.5)
     p.add_argument("--E", type=float, default=1e7, help="Young's modulus, spheres and walls")
+    p.add_argument("--L", type=float, default=1.0,
+                   help="length unit: 1, spheres a metre across; 1e-3, beads of a millimetre")
+    p.add_argument("--dt-fibre", type=float, default=0.002, help="the fix's step")
+    p.add_argument("--keywords", default="", help="more fix fibre_contact keywords")
     p.add_argument("--check", action="store_true", help="check the last step of the fix")
     p.add_argument("--methods", nargs="+", default=["fibre", "native"])
     p.add_argument("--workdir", default="scale-runs")
     a = p.parse_args()
     lmp = os.path.abspath(a.lmp)
-    print("E %g: the fix at 0.002 s, native at t_c / 20 = %.3g s (t_c %.3g s at 1 m/s)"
-          % (a.E, native_step(a.E), collision_time(a.E)))
+    print("E %g, L %g: the fix at %g s%s, native at t_c / 20 = %.3g s (t_c %.3g s at 1 m/s)"
+          % (a.E, a.L, a.dt_fibre, (" with '%s'" % a.keywords) if a.keywords else "",
+             native_step(a.E, a.L), collision_time(a.E, a.L)))
+    extra = (a.E, a.L, a.dt_fibre, a.keywords)
     print("| N | np | contacts | fix s / sim s | native s / sim s | native / fix speed | "
           "RSS fix | RSS native | fix bytes / sphere, / contact | "
           "native bytes / sphere, / contact | "
@@ -112,7 +121,7 @@ def main():
     for np in a.np:
         for m in a.methods:
             small = run(lmp, np, m, 2, 1, 0.01, False,
-                        os.path.join(os.path.abspath(a.workdir), "base"), a.E)
+                        os.path.join(os.path.abspath(a.workdir), "base"), *extra)
             base[m, np] = small["rss"] if small else 0
     for n in a.N:
         if a.width:
@@ -121,7 +130,7 @@ def main():
             W, D = max(2, round((n / (4.0 * a.depth)) ** 0.5)), a.depth
         for np in a.np:
             figs = {m: run(lmp, np, m, W, D, a.tend, a.check,
-                           os.path.join(os.path.abspath(a.workdir), "W%dD%d" % (W, D)), a.E)
+                           os.path.join(os.path.abspath(a.workdir), "W%dD%d" % (W, D)), *extra)
                     for m in a.methods}
             for m, d in figs.items():
                 if d:
