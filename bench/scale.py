@@ -1,9 +1,10 @@
 #!/usr/bin/env python3
 """The scale benchmark: fix fibre_contact against native LAMMPS on a dense bed that grows
 (bench/scale/in.bed: D fcc cells deep, W across, N = 4 W^2 D spheres settling for tend
-simulated seconds; growing in width at a fixed depth, or with --width in depth), both twins of one size and process count run back to back: the fix at its
-default step 0.002 s, native at t_c / 20 (the Hertz collision time of the smallest spheres at
-1 m/s), the step at which its bed agrees with a step 90 times smaller.
+simulated seconds; growing in width at a fixed depth, or with --width in depth), both twins of
+one size and process count run back to back: the fix at its default step 0.002 s, native at
+t_c / 20 (the Hertz collision time of the smallest spheres at 1 m/s), the step at which its
+bed agrees with a step 100 times smaller.
 
 For each run: wall seconds per simulated second, the largest resident set of any process
 (GNU time), bytes per sphere and per contact above the same method's run of 16 spheres (of the
@@ -14,8 +15,8 @@ last step, and with --check its last check's velocity error against the converge
 speed ratio is native's wall time over the fix's for the same simulated time.
 
   python3 bench/scale.py [--lmp build/fix/lmp_fibre] [--N 10000 100000] [--np 1 2]
-                         [--depth 10 | --width W] [--tend 0.5] [--E 1e7] [--L 1] [--dt-fibre 0.002]
-                         [--keywords "..."] [--check] [--workdir W]
+                         [--depth 10 | --width W] [--tend 0.5] [--E 1e7] [--L 1]
+                         [--dt-fibre 0.002] [--keywords "..."] [--check] [--workdir W]
                          [--methods ...]
 """
 
@@ -34,7 +35,9 @@ from lammps_runs import lmp_env, mpi_prefix, parse_thermo  # noqa: E402
 
 def collision_time(E, L=1.0, nu=0.3, density=2500.0, v=1.0):
     """The Hertz collision time of two of the bed's smallest spheres (radius 0.45 L) meeting at
-    v, as the fix logs it (LAMMPS's hertz/material: k_n = 4/3 E / (2 (1 - nu^2)))."""
+    v, by the fix's formula (fibre::collision_time) with LAMMPS's hertz/material pair constant
+    k_n = 4/3 E / (2 (1 - nu^2)); the fix's log names the shortest over its type pairs, which
+    may be a wall's."""
     r = 0.45 * L
     m = density * 4.0 / 3.0 * math.pi * r ** 3
     K = 4.0 / 3.0 * E / (2.0 * (1.0 - nu * nu)) * math.sqrt(0.5 * r)

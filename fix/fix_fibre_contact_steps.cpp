@@ -50,9 +50,8 @@ void FixFibreContact::smallest_body(const std::vector<fibre::Body> &bodies)
 bool FixFibreContact::note_moving_walls(const std::vector<fibre::Contact> &contacts)
 {
   if (moving_walls_met_ || !(h_ > dtv_)) return false;
-  const bool local = std::any_of(contacts.begin(), contacts.end(), [](const fibre::Contact &c) {
-    return c.is_wall() && (!c.wall_v.isZero(0.0) || !c.wall_omega.isZero(0.0));
-  });
+  const bool local = std::any_of(contacts.begin(), contacts.end(),
+                                 [](const fibre::Contact &c) { return c.wall_moves(); });
   moving_walls_met_ = exchange_->max(local ? 1.0 : 0.0) > 0.0;
   return moving_walls_met_;
 }

@@ -7,13 +7,12 @@
 // the law's heap at a fraction of the cost of n steps (the step's fixed work is done once).
 #pragma once
 
+#include <cmath>
 #include <functional>
 #include <vector>
 
 #include "fibre/algebra/spook.hpp"
 #include "fibre/core/exchange.hpp"
-#include <cmath>
-
 #include "fibre/model/contact_model.hpp"
 #include "fibre/step/step_solver.hpp"
 
