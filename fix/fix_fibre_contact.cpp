@@ -446,10 +446,20 @@ int FixFibreContact::solve_interval() const
 // Whether there were any.
 bool FixFibreContact::recover_penetrations(fibre::Substeps &steps)
 {
+  // After a displacement without room the next solves wait 1, 2, 4 ... kRecoveryWait steps (the
+  // penetrations stay split): a loaded bed's penetration without room cost a solve over every
+  // contact at every step.
+  if (recovery_wait_ > 0) {
+    --recovery_wait_;
+    return fibre::has_split_penetration(steps.system, *exchange_);
+  }
   fibre::Vector dx;
   if (!fibre::recovery_displacement(steps.system, *exchange_, steps.v_plus, h_, dx)) return false;
   // a refused displacement (recovery.hpp) is zero on every process: a jammed pack
-  if (dx.isZero(0.0) && !jammed_warned_) {
+  const bool no_room = dx.isZero(0.0);
+  recovery_backoff_ = no_room ? std::min(std::max(2 * recovery_backoff_, 1), kRecoveryWait) : 0;
+  recovery_wait_ = recovery_backoff_;
+  if (no_room && !jammed_warned_) {
     if (comm->me == 0)
       warn(error, FLERR,
            "Fix fibre_contact: penetrations have no room to open (a jammed pack: more spheres "

@@ -133,8 +133,11 @@ class FixFibreContact : public Fix {
   static constexpr int kPendingValues = 3;
   long overflow_count_ = 0;
   bool overflow_warned_ = false;
-  bool jammed_warned_ = false;    // penetrations without room to open, warned once
-  bool moving_walls_met_ = false; // a solve over several steps met a moving wall
+  bool jammed_warned_ = false;             // penetrations without room to open, warned once
+  static constexpr int kRecoveryWait = 32; // the longest wait for room (recover_penetrations)
+  int recovery_backoff_ = 0;               // the last wait for room, steps
+  int recovery_wait_ = 0;                  // steps left before the next recovery solve
+  bool moving_walls_met_ = false;          // a solve over several steps met a moving wall
 };
 
 } // namespace LAMMPS_NS

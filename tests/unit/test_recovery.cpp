@@ -175,14 +175,52 @@ TEST(Recovery, AnElasticPenetrationOpensAsARigidRow)
 
 TEST(Recovery, AKnownElasticPenetrationLeavesTheClosingToTheSpring)
 {
-  // a penetration of 0.1 kept from the last step, the overlap now 0.2: the spring holds the
-  // 0.1 the contact closed since, and the penetration stays as it was
+  // a split penetration of 0.1 kept from the last step, the overlap now 0.2: the spring holds
+  // the 0.1 the contact closed since, and the penetration stays as it was, split
   const std::vector<Body> bodies{sphere(0.0, 1.0), sphere(0.8, 1.0)};
   Contact c = sphere_sphere_contact(bodies, 1, 0);
   c.penetration = 0.1;
+  c.split = true;
   const std::vector<Contact> contacts = material(bodies, {c});
   EXPECT_EQ(contacts[0].penetration, 0.1);
+  EXPECT_TRUE(contacts[0].split);
   const ContactSystem sys(bodies, contacts, 6, params());
   const SpookParams &p = sys.params();
   EXPECT_NEAR(p.gap_term(sys.contacts()[0], p.upsilon()), 4.0 / p.h * p.upsilon() * 0.1, 1e-9);
+}
+
+// While another penetration is recovered (the floor at kPenetrationFloor), a shallow elastic
+// penetration (6 or 4 steps of max_recovery: above the floor, below kPenetrationStart), found
+// now or kept unsplit from the last step, is not split: its row pushes it open at a bounded speed
+// and the spring keeps its load's overlap. A split one stays split down to the floor's depth.
+TEST(Recovery, AShallowElasticPenetrationIsNotSplitWhileAnotherIsRecovered)
+{
+  SpookParams p = params();
+  p.penetration_floor = kPenetrationFloor;
+  const double step = p.h * p.max_recovery, overlap = 6.0 * step;
+  const std::vector<Body> bodies{sphere(0.0, 1.0), sphere(1.0 - overlap, 1.0)};
+  ContactModel model;
+  model.compliance.material = true;
+  model.materials = MaterialTable(1);
+  PairCoefficients &law = model.materials.at(1, 1);
+  law.set = true;
+  law.normal = NormalLaw::hertz_material;
+  law.k_n = 1e5;
+  Contact found = sphere_sphere_contact(bodies, 1, 0); // new: the whole overlap unexplained
+  Contact kept = found, split = found;
+  kept.penetration = 4.0 * step; // kept from the last step, unsplit
+  split.penetration = 4.0 * step;
+  split.split = true;
+  std::vector<Contact> contacts{found, kept, split};
+  for (Contact &c : contacts) c.gap = -overlap;
+  apply_contact_model(model, p, 1.0, bodies, contacts);
+  EXPECT_GT(contacts[0].penetration, 0.0);
+  EXPECT_FALSE(p.split_penetration(contacts[0]));
+  EXPECT_EQ(contacts[1].penetration, 4.0 * step);
+  EXPECT_FALSE(p.split_penetration(contacts[1]));
+  EXPECT_TRUE(p.split_penetration(contacts[2]));
+  // a split one shallower than the floor's depth is no longer split
+  contacts[2].penetration = 0.5 * kPenetrationFloor * step;
+  apply_contact_model(model, p, 1.0, bodies, contacts);
+  EXPECT_FALSE(p.split_penetration(contacts[2]));
 }

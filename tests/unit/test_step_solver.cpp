@@ -547,13 +547,16 @@ DeepStart deep_start(double v_rec, int steps)
   bodies[0].type = 1;
   Vector last = Vector::Zero(3);
   double penetration = 0.0; // what the history carries
+  bool split = false;
   bool recovering = false;
   DeepStart out;
   for (int s = 0; s < steps; ++s) {
     std::vector<Contact> contacts{sphere_wall_contact(bodies, 0, Vec3::UnitZ(), bodies[0].x.z())};
     contacts[0].penetration = penetration;
+    contacts[0].split = split;
     params.penetration_floor = recovering ? kPenetrationFloor : kPenetrationStart;
     apply_contact_model(model, params, m, bodies, contacts, &last);
+    split = contacts[0].split;
     ContactSystem sys(bodies, contacts, 3, params);
     const StepResult res = solve(sys, o);
     EXPECT_TRUE(res.converged);

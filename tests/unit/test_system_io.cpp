@@ -41,6 +41,7 @@ ContactSystem sample_system(int rows = 6)
   contacts[2].implicit_normal = true;                               // since version 8
   contacts[2].gap = -0.01;
   contacts[2].penetration = 0.75 * 0.01; // since version 9
+  contacts[2].split = true;              // since version 11
   contacts[3].pull = 2.5;                // since version 10
   contacts[3].gap_shift = -1.0 / 3.0;
   for (Contact &c : contacts) // an obstacle sphere, since version 6
@@ -97,7 +98,8 @@ void expect_identical(const ContactSystem &a, const ContactSystem &b)
                 p.damping == q.damping && p.wall_v == q.wall_v && p.wall_omega == q.wall_omega &&
                 p.elastic == q.elastic && p.spring == q.spring && p.wall_radius == q.wall_radius &&
                 p.spring_damping == q.spring_damping && p.implicit_normal == q.implicit_normal &&
-                p.penetration == q.penetration && p.pull == q.pull && p.gap_shift == q.gap_shift)
+                p.penetration == q.penetration && p.split == q.split && p.pull == q.pull &&
+                p.gap_shift == q.gap_shift)
         << "contact " << c;
   }
   EXPECT_EQ(a.row_mask(), b.row_mask());
@@ -168,7 +170,7 @@ TEST(SystemIo, RoundTripIsExact)
   for (int rows : {6, 3}) {
     const ContactSystem sys = sample_system(rows);
     const std::string text = to_text(sys);
-    EXPECT_EQ(text.rfind("fibre_contact_system 10\n", 0), 0u);
+    EXPECT_EQ(text.rfind("fibre_contact_system 11\n", 0), 0u);
     const ContactSystem back = parse_system(text);
     expect_identical(sys, back);
     EXPECT_EQ(to_text(back), text); // and the writer is deterministic
@@ -193,11 +195,12 @@ std::string older_version(const ContactSystem &sys, int version, int drop_spook,
       in_contacts = true;
       left = sys.num_contacts();
     } else if (in_contacts && left > 0) {
-      if (version < 8) { // no implicit normal rows: bit 6 of the elastic rows (token 32) cleared
+      if (version < 11) { // no implicit normal rows before 8 (bit 6 of the elastic rows, token
+        // 32), no split penetrations before 11 (bit 7): cleared
         std::vector<std::string> tokens;
         std::istringstream words(line);
         for (std::string w; words >> w;) tokens.push_back(w);
-        tokens[32] = std::to_string(std::stoi(tokens[32]) & 63);
+        tokens[32] = std::to_string(std::stoi(tokens[32]) & (version < 8 ? 63 : 127));
         line.clear();
         for (const std::string &w : tokens) line += (line.empty() ? "" : " ") + w;
       }
@@ -260,6 +263,12 @@ TEST(SystemIo, OlderVersionsAndCoefficientFields)
   EXPECT_EQ(v9.contacts()[3].pull, 0.0);
   EXPECT_EQ(v9.contacts()[3].gap_shift, 0.0);
   EXPECT_EQ(v9.contacts()[2].penetration, sys.contacts()[2].penetration);
+  // before version 11 an elastic penetration is split beyond the floor's steps of recovery
+  const ContactSystem v10 = parse_system(older_version(sys, 10, 0, 0));
+  const SpookParams &q = v10.params();
+  EXPECT_EQ(v10.contacts()[2].split,
+            v10.contacts()[2].penetration > q.penetration_floor * q.h * q.max_recovery);
+  EXPECT_TRUE(parse_system(to_text(sys)).contacts()[2].split);
   // version 8 has no penetrations
   const ContactSystem v8 = parse_system(older_version(sys, 8, 0, 3));
   EXPECT_EQ(v8.contacts()[2].penetration, 0.0);
@@ -294,7 +303,9 @@ TEST(SystemIo, OlderVersionsAndCoefficientFields)
   else
     expect_error(with(38, "-2"), {"contact 0:", "0 for a pair"});
   EXPECT_EQ(parse_system(with(25, "-1")).contacts()[0].damping, -1.0);
-  expect_error(with(32, "128"), {"contact 0:", "elastic rows must be a bit mask"});
+  expect_error(with(32, "256"), {"contact 0:", "elastic rows must be a bit mask"});
+  expect_error(with(32, "128"), {"contact 0:", "a split penetration's row must be elastic"});
+  EXPECT_TRUE(parse_system(with(32, "160")).contacts()[0].split); // since version 11
   expect_error(with(32, "64"), {"contact 0:", "an implicit normal row must be elastic"});
   EXPECT_TRUE(parse_system(with(32, "96")).contacts()[0].implicit_normal); // since version 8
   expect_error(with(33, "0.5"), {"contact 0:", "a spring on row 1, which is not elastic"});
@@ -353,7 +364,7 @@ TEST(SystemIo, EachMalformedInputGetsItsOwnError)
 
   expect_error("", {"line 1:", "unexpected end of input", "header"});
   expect_error(edit(0, "fibre_contact_sistem 1"), {"line 1:", "not a fibre_contact system"});
-  expect_error(edit(0, "fibre_contact_system 11"), {"unsupported format version 11"});
+  expect_error(edit(0, "fibre_contact_system 12"), {"unsupported format version 12"});
   expect_error(edit(0, "fibre_contact_system one"), {"'one' is not an integer"});
   expect_error(edit(2, "rows 4"), {"rows must be 3 or 6"});
   expect_error(edit(3, "spook 0 2"), {"time step h must be positive"});

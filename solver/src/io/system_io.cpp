@@ -32,6 +32,7 @@ constexpr int kContactFieldsV8 = kContactFieldsV6 + kMaxRows - 1;
 // version 9: + the normal row's penetration (Contact::penetration)
 constexpr int kContactFieldsV9 = kContactFieldsV8 + 1;
 // version 10: + cohesion's pull-off force and gap shift (Contact::pull, gap_shift)
+// version 11: the same, with bit 7 of the elastic rows for a split penetration (Contact::split)
 constexpr int kContactFields = kContactFieldsV9 + 2;
 // Unit vectors must read back as unit vectors; exported data are far more exact than this.
 constexpr double kUnitTol = 1e-6;
@@ -243,6 +244,7 @@ void write_system(std::ostream &out, const ContactSystem &sys)
     for (const Vec3 *v : {&c.wall_v, &c.wall_omega}) put_vec(s, *v);
     int elastic = c.elastic[0] ? 1 << (kMaxRows - 1) : 0;
     if (c.implicit_normal) elastic |= 1 << kMaxRows;
+    if (c.split) elastic |= 1 << (kMaxRows + 1);
     for (int r = 1; r < kMaxRows; ++r) elastic |= c.elastic[r] ? 1 << (r - 1) : 0;
     s += ' ' + std::to_string(elastic);
     for (int r = 1; r < kMaxRows; ++r) {
@@ -429,13 +431,19 @@ void read_contact_coefficients(Reader &in, const Tokens &t, const std::string &w
   if (version <= 7 && (elastic < 0 || elastic >= (1 << kMaxRows)))
     in.fail(what + ": elastic rows must be a bit mask of rows 1 to 5 and the normal row, in [0, "
                    "63]");
-  if (elastic < 0 || elastic >= (1 << (kMaxRows + 1)))
+  if (version <= 10 && (elastic < 0 || elastic >= (1 << (kMaxRows + 1))))
     in.fail(what + ": elastic rows must be a bit mask of rows 1 to 5, the normal row and its "
                    "implicit relaxation, in [0, 127]");
+  if (elastic < 0 || elastic >= (1 << (kMaxRows + 2)))
+    in.fail(what + ": elastic rows must be a bit mask of rows 1 to 5, the normal row, its "
+                   "implicit relaxation and a split penetration, in [0, 255]");
   k.elastic[0] = (elastic >> (kMaxRows - 1)) & 1;
   k.implicit_normal = (elastic >> kMaxRows) & 1;
+  k.split = (elastic >> (kMaxRows + 1)) & 1;
   if (k.implicit_normal && !k.elastic[0])
     in.fail(what + ": an implicit normal row must be elastic (bit 5)");
+  if (k.split && !k.elastic[0])
+    in.fail(what + ": a split penetration's row must be elastic (bit 5)");
   for (int r = 1; r < kMaxRows; ++r) {
     k.elastic[r] = (elastic >> (r - 1)) & 1;
     k.spring[r] = in.real(t[kContactFieldsV3 + r], what + " spring");
@@ -529,6 +537,10 @@ ContactSystem parse_system(std::string_view text)
   std::vector<Body> bodies = read_bodies(in, t, owned);
   const int nb = static_cast<int>(bodies.size());
   std::vector<Contact> contacts = read_contacts(in, t, version, nb, static_cast<int>(rows));
+  if (version <= 10) // split as the readers of these versions did: beyond the floor
+    for (Contact &k : contacts)
+      k.split =
+          k.elastic[0] && k.penetration > params.penetration_floor * params.h * params.max_recovery;
   const long long dofs = rows * static_cast<long long>(contacts.size());
   const std::vector<unsigned char> mask = read_mask(in, t, dofs);
   const Vector rhs = read_rhs(in, t, dofs);

@@ -1,6 +1,7 @@
 #include "fibre/model/contact_history.hpp"
 
 #include <algorithm>
+#include <cmath>
 
 namespace fibre {
 
@@ -88,6 +89,7 @@ void ContactHistory::load_springs(const std::vector<ContactTag> &tags,
     Contact &k = contacts[c];
     k.spring.fill(0.0);
     k.penetration = 0.0;
+    k.split = false;
     const double *slot = find(tags[c].store, tags[c].key);
     k.touched = slot != nullptr;
     if (!slot) continue;
@@ -98,7 +100,8 @@ void ContactHistory::load_springs(const std::vector<ContactTag> &tags,
     k.spring[3] = slot[13];
     k.spring[4] = rolling.dot(k.t1);
     k.spring[5] = rolling.dot(k.t2);
-    k.penetration = slot[14];
+    k.penetration = std::abs(slot[14]);
+    k.split = slot[14] < 0;
   }
 }
 
@@ -138,7 +141,7 @@ void ContactHistory::write_slot(double *slot, double key, const Contact &k, cons
     slot[10 + d] = rolling[d];
   }
   slot[13] = twisting;
-  slot[14] = xi ? (*xi)[0] : 0.0;
+  slot[14] = xi ? (k.split ? -(*xi)[0] : (*xi)[0]) : 0.0; // a split penetration negative
 }
 
 long ContactHistory::store(const std::vector<ContactTag> &tags,

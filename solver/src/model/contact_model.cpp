@@ -84,6 +84,20 @@ void track_penetration(const SpookParams &params, double explained_overlap, doub
   c.penetration = excess > params.h * params.max_recovery ? excess : 0.0;
 }
 
+// Contact::split of an elastic row's penetration: one found deeper than kPenetrationStart steps
+// of max_recovery is split, and stays split while deeper than kPenetrationFloor steps (the
+// recovery's displacement leaves up to a step of max_recovery in a crowded bed, which the row's
+// velocity would remove at max_recovery where the bed has no room: at a floor of 1, spheres
+// inserted into a bed reached 27 m/s; at 0.01, 4.6). One found shallower is never split: a
+// soft deep bed holds thousands, and splitting them while another was recovered cost a
+// recovery solve every step and took their loads' overlap out of their springs.
+void mark_split(const SpookParams &params, bool known, Contact &c)
+{
+  const double step = params.h * params.max_recovery;
+  c.split = known ? c.split && c.penetration > kPenetrationFloor * step
+                  : c.penetration > kPenetrationStart * step;
+}
+
 // A rigid normal row's penetration (compliance auto, or a law without a stiffness): its whole
 // overlap, where it is more than twice the row's at its last load (eps F: SPOOK's rows at rest
 // overlap so), the step's closing and penetration_floor steps of recovery. The velocity
@@ -157,12 +171,11 @@ void elastic_row(const PairCoefficients &pc, const SpookParams &params, double r
 {
   const bool known = c.penetration > 0;
   track_penetration(params, law_overlap(pc, reff, force), overlap, approach, c);
-  // A deep new one is split (SpookParams::split_penetration) as a rigid row's is: its whole
-  // overlap, so that its spring holds no load's overlap in a cage the displacement cannot open
-  // (a sphere deposited into a bed then pushed its cage apart at 11 m/s). The spring then
-  // carries what the contact closes from there.
-  if (!known && c.penetration > params.penetration_floor * params.h * params.max_recovery)
-    c.penetration = overlap;
+  mark_split(params, known, c);
+  // A deep new one is split as a rigid row's is: its whole overlap, so that its spring holds no
+  // load's overlap in a cage the displacement cannot open (a sphere deposited into a bed then
+  // pushed its cage apart at 11 m/s). The spring then carries what the contact closes from there.
+  if (!known && c.split) c.penetration = overlap;
   const std::array<double, kMaxRows> rigid = c.compliance;
   // A penetration's row keeps the law's compliance at its overlap (its last force was the
   // recovery's), so that it leaves no faster than the law's spring would push it: a soft
@@ -192,7 +205,9 @@ void apply_pair(const ContactModel &model, const PairCoefficients &pc, const Spo
   const double force = last_normal / h;
   if (cohesive) {
     const double explained = cohesive_row(pc, reff, overlap, last_raw / h, c);
+    const bool known = c.penetration > 0;
     track_penetration(params, explained, overlap, normal_approach(bodies, c), c);
+    mark_split(params, known, c);
   } else {
     elastic_row(pc, params, reff, overlap, force, normal_approach(bodies, c), c);
   }

@@ -90,6 +90,12 @@ struct Contact {
   // normal row's penetration is its overlap, removed by the split recovery's displacement
   // (step/recovery.hpp); its velocity row asks only that it does not close.
   double penetration = 0.0;
+  // Whether an elastic row's penetration is split (opened by the split recovery, its row asking
+  // only that it does not close): set by the contact model when the penetration is first found
+  // deep, kept by the history until it is shallow, never set on a penetration found shallow
+  // (in a soft deep bed thousands are, and splitting them all each step both cost the
+  // recovery's solve each step and took the load's overlap out of their springs).
+  bool split = false;
   // An elastic normal row relaxed as the law's Kelvin-Voigt element (spring 1 / eps, dashpot
   // time tau) by implicit Euler, G v+ (h + tau) + eps lambda / h = -gap: SPOOK's row at
   // damping = 3/4 + tau / h without the memory Upsilon G v of the approach speed (spook_rhs).
@@ -190,7 +196,7 @@ struct SpookParams {
   // A rigid row's overlap is a penetration (step/recovery.hpp) beyond this many steps of
   // max_recovery (and what its load and the step's closing explain): kPenetrationStart
   // (contact_model.hpp) in a run's ordinary steps, kPenetrationFloor while penetrations are
-  // being recovered.
+  // being recovered. (An elastic row's split is its own: Contact::split.)
   double penetration_floor = 10.0;
   // A contact's damping: its own when set (Contact::damping >= 0), else the system's.
   double damping_of(const Contact &c) const { return c.damping >= 0 ? c.damping : damping; }
@@ -201,12 +207,12 @@ struct SpookParams {
   }
   // Whether contact c's penetration is removed by the split recovery's displacement
   // (step/recovery.hpp), not by its row's velocity: a rigid row's (the contact model sets it
-  // beyond penetration_floor steps of max_recovery), and an elastic row's beyond the same
-  // floor (shallower ones are pushed open by the row's bounded velocity, below).
+  // beyond penetration_floor steps of max_recovery), and an elastic row's marked split
+  // (Contact::split; shallower ones are pushed open by the row's bounded velocity, below).
   bool split_penetration(const Contact &c) const
   {
     if (!(c.penetration > 0)) return false;
-    return !c.elastic[0] || c.penetration > penetration_floor * h * max_recovery;
+    return !c.elastic[0] || c.split;
   }
   // The gap term of the normal row's rhs, -(4 / h) Upsilon g, bounded by max_recovery unless
   // the row is the material's spring (Contact::elastic[0]): bounding an elastic overlap would

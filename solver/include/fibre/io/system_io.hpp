@@ -35,7 +35,7 @@ namespace fibre {
 // 2: friction per contact; 3: restitution, damping and wall velocity per contact and the bounce
 // speed; 4, 5: elastic rows and their springs; 6: an obstacle's radius; 7: the springs' own
 // damping; 8: implicit normal rows. Every older version is read (doc/system_format.md).
-inline constexpr int kSystemFormatVersion = 10;
+inline constexpr int kSystemFormatVersion = 11;
 
 void write_system(std::ostream &out, const ContactSystem &sys);
 // Throws std::runtime_error when the file cannot be written.

@@ -19,7 +19,8 @@ class ContactHistory {
   static constexpr int kMaxSlots = 16;
   // key (the other side's tag, or a wall key), then force and torque (impulse / h) acting on
   // the contact's body a, then the tangential displacement (3), the rolling angle (3) and the
-  // twisting angle (1), and the penetration left (Contact::penetration).
+  // twisting angle (1), and the penetration left (Contact::penetration; negated where it is
+  // split, Contact::split).
   static constexpr int kSlotSize = 15;
   static constexpr int kSpringSlot = 14; // files without the penetration
   static constexpr int kMaxPacked = 1 + kMaxSlots * kSlotSize;
@@ -45,7 +46,7 @@ class ContactHistory {
                     int rows, double h) const;
   // Contact::spring of every stored contact in this step's frame: the stored tangential and
   // rolling vectors turned into the new tangent plane with their length kept (LAMMPS's rule),
-  // the twisting angle as it is; Contact::penetration, and Contact::touched (stored).
+  // the twisting angle as it is; Contact::penetration and split, and Contact::touched (stored).
   void load_springs(const std::vector<ContactTag> &tags, std::vector<Contact> &contacts) const;
   // Replaces every stored contact by this step's pressing (cohesive ones: or pulling)
   // contacts, with their springs at the step's end (advance_springs, rows per contact, row 0

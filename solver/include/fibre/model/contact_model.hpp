@@ -108,7 +108,9 @@ inline constexpr double kRoundoffLoad = 1e-9;
 // velocities. While penetrations are being recovered, beyond kPenetrationFloor of a step: the
 // recovery's displacement leaves overlaps of up to a step of max_recovery in a crowded bed,
 // which the rows' velocities would remove at max_recovery where the bed has no room (at a
-// floor of 1, spheres inserted into a bed reached 27 m/s; at 0.01, 4.6).
+// floor of 1, spheres inserted into a bed reached 27 m/s; at 0.01, 4.6). An elastic row's
+// penetration is split when found beyond kPenetrationStart steps and stays split down to
+// kPenetrationFloor (Contact::split).
 inline constexpr double kPenetrationStart = 10.0;
 inline constexpr double kPenetrationFloor = 0.01;
 
