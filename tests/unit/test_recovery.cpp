@@ -46,7 +46,7 @@ std::vector<Contact> modelled(const std::vector<Body> &bodies, std::vector<Conta
 }
 
 // compliance material with one soft Hertz law (E about 1e5: Sigma is many times w)
-std::vector<Contact> material(const std::vector<Body> &bodies, std::vector<Contact> contacts)
+ContactModel soft_material()
 {
   ContactModel model;
   model.compliance.automatic = false;
@@ -56,7 +56,13 @@ std::vector<Contact> material(const std::vector<Body> &bodies, std::vector<Conta
   law.set = true;
   law.normal = NormalLaw::hertz_material;
   law.k_n = 1e5;
-  apply_contact_model(model, params(), 1.0, bodies, contacts);
+  return model;
+}
+
+// soft_material's contact model on the contacts
+std::vector<Contact> material(const std::vector<Body> &bodies, std::vector<Contact> contacts)
+{
+  apply_contact_model(soft_material(), params(), 1.0, bodies, contacts);
   return contacts;
 }
 
@@ -199,13 +205,7 @@ TEST(Recovery, AShallowElasticPenetrationIsNotSplitWhileAnotherIsRecovered)
   p.penetration_floor = kPenetrationFloor;
   const double step = p.h * p.max_recovery, overlap = 6.0 * step;
   const std::vector<Body> bodies{sphere(0.0, 1.0), sphere(1.0 - overlap, 1.0)};
-  ContactModel model;
-  model.compliance.material = true;
-  model.materials = MaterialTable(1);
-  PairCoefficients &law = model.materials.at(1, 1);
-  law.set = true;
-  law.normal = NormalLaw::hertz_material;
-  law.k_n = 1e5;
+  const ContactModel model = soft_material();
   Contact found = sphere_sphere_contact(bodies, 1, 0); // new: the whole overlap unexplained
   Contact kept = found, split = found;
   kept.penetration = 4.0 * step; // kept from the last step, unsplit
