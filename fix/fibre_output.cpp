@@ -226,6 +226,7 @@ void FibreOutput::read_restart(const char *buf)
 {
   const double *list = reinterpret_cast<const double *>(buf);
   const int values = list[0] == kRestartFormat ? V_SIZE
+                     : list[0] == 6.0          ? V_SPLIT
                      : list[0] == 5.0          ? V_SUBSTEPS
                      : list[0] == 4.0          ? V_CHECK_VELOCITY
                      : list[0] == 3.0          ? V_WALL_WORK

@@ -39,13 +39,14 @@ enum Stat {
   V_CHECK_VELOCITY, // the last check's errors against the converged step (keyword check)
   V_CHECK_IMPULSE,
   V_SUBSTEPS, // the last step's contact solves (its substeps; 1 where nothing moved)
+  V_SPLIT,    // the last step's penetrations opened by the split recovery
   V_SIZE
 };
 
 class FibreOutput : protected LAMMPS_NS::Pointers {
  public:
   static constexpr int kLocalColumns = 8;
-  static constexpr double kRestartFormat = 6.0; // 6: 21 global values (5: 20, 4: 18, 3: 16, 2: 15)
+  static constexpr double kRestartFormat = 7.0; // 7: 22 global values (6: 21, 5: 20, 4: 18, ...)
 
   explicit FibreOutput(LAMMPS_NS::LAMMPS *lmp) : Pointers(lmp)
   {
@@ -70,6 +71,7 @@ class FibreOutput : protected LAMMPS_NS::Pointers {
   // 100 steps while solves fail. A step without contacts reports an empty, converged result.
   void report_solve(const fibre::StepResult &res);
   void report_substeps(int done) { stats_[V_SUBSTEPS] = done; }
+  void report_split(long penetrations) { stats_[V_SPLIT] = static_cast<double>(penetrations); }
   // Adds one step's work of the contacts (this process's contacts; summed here).
   void add_work(const fibre::ContactWork &work);
   // A check's errors (keyword check), with a warning where its reference did not converge.

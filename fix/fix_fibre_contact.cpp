@@ -449,9 +449,12 @@ bool FixFibreContact::recover_penetrations(fibre::Substeps &steps)
   // After a displacement without room the next solves wait 1, 2, 4 ... kRecoveryWait steps (the
   // penetrations stay split): a loaded bed's penetration without room cost a solve over every
   // contact at every step.
+  const long split = fibre::split_penetrations(steps.system, *exchange_);
+  output_->report_split(split);
+  if (split == 0) return false;
   if (recovery_wait_ > 0) {
     --recovery_wait_;
-    return fibre::has_split_penetration(steps.system, *exchange_);
+    return true;
   }
   fibre::Vector dx;
   if (!fibre::recovery_displacement(steps.system, *exchange_, steps.v_plus, h_, dx)) return false;
@@ -617,6 +620,7 @@ void FixFibreContact::final_integrate()
     tally_virial(sys, lambda_mean.size() ? lambda_mean : fibre::Vector::Zero(sys.contact_dofs()));
   // the energy the moving walls put in and the contacts take out
   recovering_ = false;
+  output_->report_split(0);
   if (solved) {
     if (substepped) follow_substeps(steps.path, steps.done, hs);
     if (every > 1) follow_solve_step(every);

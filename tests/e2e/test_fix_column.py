@@ -127,7 +127,7 @@ def main():
             # format version 4; each line: index, tags, wall, the
             # impulses and the warm start of every row
             rows = [int(line.split()[1]) for line in sys_lines if line.startswith("rows")]
-            ck.check(sys_lines[0] == "fibre_contact_system 10" and ncont == [len(contacts)]
+            ck.check(sys_lines[0] == "fibre_contact_system 11" and ncont == [len(contacts)]
                      and len(lam) == len(contacts) and err < 1e-12
                      and all(len(w) == 4 + 2 * rows[0] for w in lam),
                      "%s: export writes the system and the same impulses" % tag,

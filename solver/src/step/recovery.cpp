@@ -82,13 +82,19 @@ bool shuffles(const ContactSystem &sys, const Exchange &ex, const Vector &Gv, co
 
 } // namespace
 
-bool has_split_penetration(const ContactSystem &sys, const Exchange &ex)
+long split_penetrations(const ContactSystem &sys, const Exchange &ex)
 {
   const SpookParams &p = sys.params();
-  double any = std::any_of(sys.contacts().begin(), sys.contacts().end(),
-                           [&p](const Contact &c) { return p.split_penetration(c); });
-  ex.max(&any, 1);
-  return any > 0;
+  double count =
+      static_cast<double>(std::count_if(sys.contacts().begin(), sys.contacts().end(),
+                                        [&p](const Contact &c) { return p.split_penetration(c); }));
+  ex.sum(&count, 1);
+  return static_cast<long>(count);
+}
+
+bool has_split_penetration(const ContactSystem &sys, const Exchange &ex)
+{
+  return split_penetrations(sys, ex) > 0;
 }
 
 bool recovery_displacement(const ContactSystem &sys, const Exchange &ex, const Vector &v_plus,

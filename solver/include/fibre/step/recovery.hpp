@@ -15,8 +15,9 @@
 
 namespace fibre {
 
-// Whether a contact of any process has a penetration that the split recovery opens
-// (SpookParams::split_penetration; collective).
+// How many contacts of all processes have a penetration that the split recovery opens
+// (SpookParams::split_penetration; collective), and whether any has.
+long split_penetrations(const ContactSystem &sys, const Exchange &ex);
 bool has_split_penetration(const ContactSystem &sys, const Exchange &ex);
 
 // The displacement of every body (6 per body, owned and ghosts; the rotations zero) that opens
