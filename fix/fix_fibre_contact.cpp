@@ -458,8 +458,11 @@ bool FixFibreContact::recover_penetrations(fibre::Substeps &steps)
   }
   fibre::Vector dx;
   if (!fibre::recovery_displacement(steps.system, *exchange_, steps.v_plus, h_, dx)) return false;
-  // a refused displacement (recovery.hpp) is zero on every process: a jammed pack
-  const bool no_room = dx.isZero(0.0);
+  // a refused displacement (recovery.hpp) is zero on every process: a jammed pack (decided
+  // over all processes: a process whose bodies do not move, or that has none, has a zero dx)
+  double moved = dx.isZero(0.0) ? 0.0 : 1.0;
+  exchange_->max(&moved, 1);
+  const bool no_room = moved == 0.0;
   recovery_backoff_ = no_room ? std::min(std::max(2 * recovery_backoff_, 1), kRecoveryWait) : 0;
   recovery_wait_ = recovery_backoff_;
   if (no_room && !jammed_warned_) {
