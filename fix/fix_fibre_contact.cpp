@@ -449,20 +449,18 @@ bool FixFibreContact::recover_penetrations(fibre::Substeps &steps)
   // After a displacement without room the next solves wait 1, 2, 4 ... kRecoveryWait steps (the
   // penetrations stay split): a loaded bed's penetration without room cost a solve over every
   // contact at every step.
-  const long split = fibre::split_penetrations(steps.system, *exchange_);
-  output_->report_split(split);
-  if (split == 0) return false;
   if (recovery_wait_ > 0) {
-    --recovery_wait_;
-    return true;
+    const long split = fibre::split_penetrations(steps.system, *exchange_);
+    output_->report_split(split);
+    if (split > 0) --recovery_wait_;
+    return split > 0;
   }
   fibre::Vector dx;
-  if (!fibre::recovery_displacement(steps.system, *exchange_, steps.v_plus, h_, dx)) return false;
-  // a refused displacement (recovery.hpp) is zero on every process: a jammed pack (decided
-  // over all processes: a process whose bodies do not move, or that has none, has a zero dx)
-  double moved = dx.isZero(0.0) ? 0.0 : 1.0;
-  exchange_->max(&moved, 1);
-  const bool no_room = moved == 0.0;
+  const fibre::Recovery recovery =
+      fibre::recovery_displacement(steps.system, *exchange_, steps.v_plus, h_, dx);
+  output_->report_split(recovery.split);
+  if (recovery.outcome == fibre::Recovery::Outcome::none) return false;
+  const bool no_room = recovery.outcome == fibre::Recovery::Outcome::refused;
   recovery_backoff_ = no_room ? std::min(std::max(2 * recovery_backoff_, 1), kRecoveryWait) : 0;
   recovery_wait_ = recovery_backoff_;
   if (no_room && !jammed_warned_) {

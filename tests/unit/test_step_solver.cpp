@@ -564,7 +564,8 @@ DeepStart deep_start(double v_rec, int steps)
     const Vector v_plus = velocities_after(sys, serial_exchange(), res.lambda);
     std::vector<std::array<double, kMaxRows>> springs = advance_springs(sys, v_plus, res.lambda);
     Vector dx;
-    recovering = recovery_displacement(sys, serial_exchange(), v_plus, kH, dx);
+    recovering = recovery_displacement(sys, serial_exchange(), v_plus, kH, dx).outcome !=
+                 Recovery::Outcome::none;
     if (recovering) {
       take_opening(sys, dx, springs);
       bodies[0].x += dx.head<3>();

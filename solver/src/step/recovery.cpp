@@ -92,15 +92,12 @@ long split_penetrations(const ContactSystem &sys, const Exchange &ex)
   return static_cast<long>(count);
 }
 
-bool has_split_penetration(const ContactSystem &sys, const Exchange &ex)
+Recovery recovery_displacement(const ContactSystem &sys, const Exchange &ex, const Vector &v_plus,
+                               double span, Vector &dx, int max_sweeps)
 {
-  return split_penetrations(sys, ex) > 0;
-}
-
-bool recovery_displacement(const ContactSystem &sys, const Exchange &ex, const Vector &v_plus,
-                           double span, Vector &dx, int max_sweeps)
-{
-  if (!has_split_penetration(sys, ex)) return false;
+  Recovery recovery;
+  recovery.split = split_penetrations(sys, ex);
+  if (recovery.split == 0) return recovery;
   const std::unique_ptr<ContactSystem> rigid = rigid_rows(sys);
   const ContactSystem &solved = rigid ? *rigid : sys;
   const Cones frictionless = Cones::frictionless(solved);
@@ -122,8 +119,12 @@ bool recovery_displacement(const ContactSystem &sys, const Exchange &ex, const V
   }
   ex.max(&fastest, 1);
   dx *= fastest > reach ? span * reach / fastest : span;
-  if (shuffles(sys, ex, Gv, dx)) dx.setZero(); // no room: the penetrations stay
-  return true;
+  recovery.outcome = Recovery::Outcome::opened;
+  if (shuffles(sys, ex, Gv, dx)) { // no room: the penetrations stay
+    dx.setZero();
+    recovery.outcome = Recovery::Outcome::refused;
+  }
+  return recovery;
 }
 
 void take_opening(const ContactSystem &sys, const Vector &dx,

@@ -16,9 +16,19 @@
 namespace fibre {
 
 // How many contacts of all processes have a penetration that the split recovery opens
-// (SpookParams::split_penetration; collective), and whether any has.
+// (SpookParams::split_penetration; collective).
 long split_penetrations(const ContactSystem &sys, const Exchange &ex);
-bool has_split_penetration(const ContactSystem &sys, const Exchange &ex);
+
+// What recovery_displacement did, alike on every process.
+struct Recovery {
+  enum class Outcome {
+    none,    // no process has a split penetration: dx untouched
+    opened,  // dx opens them
+    refused, // no room (a jammed pack): dx is zero
+  };
+  Outcome outcome = Outcome::none;
+  long split = 0; // split_penetrations
+};
 
 // The displacement of every body (6 per body, owned and ghosts; the rotations zero) that opens
 // the split penetrations left after the step (the gaps advanced by h G v_plus, h the system's)
@@ -29,9 +39,9 @@ bool has_split_penetration(const ContactSystem &sys, const Exchange &ex);
 // most of what it opens (a jammed pack, more spheres than its box holds) is not taken: dx is
 // zero, and the penetrations stay until there is room. span is the step the displacement is
 // taken over: the system's h, or the whole step where the system is its last substep's.
-// Collective; false, dx untouched, where no process has a penetration.
-bool recovery_displacement(const ContactSystem &sys, const Exchange &ex, const Vector &v_plus,
-                           double span, Vector &dx, int max_sweeps = 100);
+// Collective.
+Recovery recovery_displacement(const ContactSystem &sys, const Exchange &ex, const Vector &v_plus,
+                               double span, Vector &dx, int max_sweeps = 100);
 
 // An elastic row's penetration left after the displacement dx: springs[c][0] (the penetration
 // left after the step, Substeps::springs) less the opening G_n dx of a split one, so that the
