@@ -86,6 +86,20 @@ def cubic_bed(width, height):
                       "displace_atoms all move 0.5 0.5 0.5 units box"])
 
 
+def bed_under_gravity(box, width, height, law, density, timestep, processors, created=None):
+    """The opening of a deck whose unit spheres (a `cubic_bed` width x width x height in a box of
+    `sphere_box`, and optionally the `created` lines after it) have `density` and the
+    `pair_style granular` law `law`, with a bin neighbour list rebuilt at every step, the step
+    `timestep` and gravity along -z. The numbers are strings: a template's fields stay as
+    they are."""
+    lines = ["units si"] + sphere_box(box, processors=processors) + [cubic_bed(width, height)]
+    lines += [created] if created else []
+    return "\n".join(lines + [
+        "set type 1 diameter 1.0", "set type 1 density " + density, "pair_style granular",
+        "pair_coeff * * " + law, "neighbor 0.3 bin", "neigh_modify every 1 delay 0",
+        "timestep " + timestep, "fix g all gravity 9.81 vector 0 0 -1"])
+
+
 def stacked_column(diameters):
     """Spheres of these diameters stacked on z = 0 along the z axis, each touching the next:
     their centres' heights and the create_atoms and set lines (density 1) that make them."""

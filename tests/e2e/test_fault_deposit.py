@@ -15,16 +15,7 @@ import fibre_e2e as e2e
 LAW = "hertz/material 1e6 0.3 0.3 tangential mindlin NULL 1.0 0.5 damping tsuji"
 WALL = "wall granular " + LAW
 
-DECK = "\n".join(["units si"] + e2e.sphere_box("0 6 0 6 0 10", processors="{procs}") +
-                 [e2e.cubic_bed(6, 3)]) + """
-set type 1 diameter 1.0
-set type 1 density 1.0
-pair_style granular
-pair_coeff * * """ + LAW + """
-neighbor 0.3 bin
-neigh_modify every 1 delay 0
-timestep {dt}
-fix g all gravity 9.81 vector 0 0 -1
+DECK = e2e.bed_under_gravity("0 6 0 6 0 10", 6, 3, LAW, "1.0", "{dt}", "{procs}") + """
 region ins block 0.5 5.5 0.5 5.5 0.5 2.5 units box
 fix d all deposit 30 1 {every} 4767 region ins units box
 {integrate}

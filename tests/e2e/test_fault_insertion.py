@@ -21,17 +21,8 @@ import fibre_e2e as e2e
 LAW = "hertz/material 1e8 0.3 0.3 tangential mindlin NULL 1.0 0.5 damping tsuji"
 WALL = "granular " + LAW
 
-DECK = "\n".join(["units si"] + e2e.sphere_box("0 6 0 6 0 10", processors="{procs}") +
-                 [e2e.cubic_bed(6, 3)]) + """
-create_atoms 1 random 30 1234 bed
-set type 1 diameter 1.0
-set type 1 density 2500
-pair_style granular
-pair_coeff * * """ + LAW + """
-neighbor 0.3 bin
-neigh_modify every 1 delay 0
-timestep 0.001
-fix g all gravity 9.81 vector 0 0 -1
+DECK = e2e.bed_under_gravity("0 6 0 6 0 10", 6, 3, LAW, "2500", "0.001", "{procs}",
+                              "create_atoms 1 random 30 1234 bed") + """
 fix f all fibre_contact wall {W} xplane 0 6 wall {W} yplane 0 6 wall {W} zplane 0 NULL {extra}
 variable speed atom sqrt(vx*vx+vy*vy+vz*vz)
 compute fastest all reduce max v_speed
