@@ -131,8 +131,28 @@ def main():
             ck.check(e2e.rel_err(ff.get("rate", 0), fn.get("rate", 1)) < 0.25,
                      tag + "the discharge rate within 25% of native",
                      "%s vs %s" % (ff.get("rate"), fn.get("rate")))
+        drum_intended(ck, official, args, np)
     mixer_every(ck, official, args)
     ck.close()
+
+
+def drum_intended(ck, official, args, np):
+    """pour.drum as its comments intend against native on np processes."""
+    tag = "pour.drum.intended np %d: " % np
+    drum = twins(ck, official, args, "pour.drum.intended", np)
+    if not drum:
+        return
+    fn, ff, _ = drum
+    ck.check(ff.get("atoms") == fn.get("atoms") and fn.get("atoms", 0) > 2000,
+             tag + "the same grains kept (the deck deletes those above half the drum)",
+             "fix %s, native %s" % (ff.get("atoms"), fn.get("atoms")))
+    centre = 15.0  # the drum's axis: x = y = 15
+    for key, what, band, origin in (("xc", "shift up the rising wall", 0.15, centre),
+                                    ("yc", "height across the drum", 0.10, 0.0),
+                                    ("zc", "height along the axis", 0.10, 0.0)):
+        ck.check(e2e.rel_err(ff.get(key, 0) - origin, fn.get(key, 1) - origin) < band,
+                 tag + "the bed centre's %s within %d%% of native" % (what, round(100 * band)),
+                 "%.4g vs %.4g" % (ff.get(key, 0) - origin, fn.get(key, 1) - origin))
 
 
 def mixer_every(ck, official, args):
