@@ -196,8 +196,7 @@ bool LammpsDetection::accept(const fibre::Body &a, const fibre::Body *b, const f
 // newton_pair on a pair with a ghost is listed on one process only; with newton_pair off it is
 // listed on both and the process owning the atom with the smaller tag keeps it.
 void LammpsDetection::pair_contacts(const std::vector<fibre::Body> &bodies, double h,
-                                    double damping,
-                                    std::vector<fibre::DetectedContact> &found) const
+                                    double damping, std::vector<fibre::DetectedContact> &found)
 {
   std::string style;
   NeighList *list = fibre_lmp::granular_pair(lmp, style)->list;
@@ -207,15 +206,23 @@ void LammpsDetection::pair_contacts(const std::vector<fibre::Body> &bodies, doub
   const double *radius = atom->radius;
   const bool newton_pair = force->newton_pair != 0;
   const double reach = neighbor->skin; // pairs beyond radsum + skin are not in the list
+  const bool impact_pass = !kick_.empty();
+  if (!impact_pass) {
+    std::size_t listed = 0;
+    for (int ii = 0; ii < list->inum; ++ii) listed += list->numneigh[list->ilist[ii]];
+    taken_.assign(listed, 0);
+  }
 
+  std::size_t pair = 0;
   for (int ii = 0; ii < list->inum; ++ii) {
     const int i = list->ilist[ii];
     const int *jlist = list->firstneigh[i];
-    for (int jj = 0; jj < list->numneigh[i]; ++jj) {
+    for (int jj = 0; jj < list->numneigh[i]; ++jj, ++pair) {
       const int j = jlist[jj] & NEIGHMASK;
       const int bi = atom_body_[i], bj = atom_body_[j];
       if (bi < 0 && bj < 0) continue;
-      if (!kick_.empty() && !(bi >= 0 && kick_[bi] > 0) && !(bj >= 0 && kick_[bj] > 0))
+      if (impact_pass &&
+          (taken_[pair] || (!(bi >= 0 && kick_[bi] > 0) && !(bj >= 0 && kick_[bj] > 0))))
         continue;                     // the impact pass: nothing new within reach
       if (tag[i] == tag[j]) continue; // a periodic image of itself
       if (j >= nlocal && !newton_pair && tag[i] > tag[j]) continue;
@@ -252,6 +259,7 @@ void LammpsDetection::pair_contacts(const std::vector<fibre::Body> &bodies, doub
         fc.tag_a = tag[low];
         fc.partner = static_cast<double>(tag[high]);
         keep(fc);
+        taken_[pair] = 1;
       } else {
         // one atom is outside the group: a fixed spherical obstacle
         const int g = bi >= 0 ? i : j, o = g == i ? j : i;
@@ -274,6 +282,7 @@ void LammpsDetection::pair_contacts(const std::vector<fibre::Body> &bodies, doub
         fc.partner = static_cast<double>(tag[o]);
         keep(fc);
         found.push_back(std::move(fc));
+        taken_[pair] = 1;
       }
     }
   }

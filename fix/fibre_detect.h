@@ -50,7 +50,7 @@ class LammpsDetection : protected LAMMPS_NS::Pointers {
 
  private:
   void pair_contacts(const std::vector<fibre::Body> &bodies, double h, double damping,
-                     std::vector<fibre::DetectedContact> &found) const;
+                     std::vector<fibre::DetectedContact> &found);
   void impact_kicks(const std::vector<fibre::Body> &bodies, double h,
                     const std::vector<fibre::DetectedContact> &found, fibre::Vector &kick) const;
   void wall_contacts(const std::vector<fibre::Body> &bodies, double h, double damping,
@@ -86,7 +86,10 @@ class LammpsDetection : protected LAMMPS_NS::Pointers {
   std::vector<fibre::WallSpec> walls_;
   const fibre::MaterialTable *materials_ = nullptr; // set when some type pair is JKR
   double wall_time_ = 0.0;
-  std::vector<double> kick_;   // per body: the speed an impact may give it this step
+  std::vector<double> kick_; // per body: the speed an impact may give it this step
+  // per listed pair, in the list's order: a contact of the first pass, which the impact pass
+  // would only reject again (its accept asks for a contact that the first pass did not take)
+  std::vector<unsigned char> taken_;
   std::vector<double> speed_;  // per body: its free speed over this step (fibre::free_speed)
   std::size_t last_found_ = 0; // contacts found in the last step
   std::unique_ptr<HostWalls> host_walls_;
