@@ -619,14 +619,14 @@ void FixFibreContact::final_integrate()
   // this step's virial is wanted (post_force), or the steps' to the next solve
   if (evflag || next_solve_ > update->ntimestep + 1)
     tally_virial(sys, lambda_mean.size() ? lambda_mean : fibre::Vector::Zero(sys.contact_dofs()));
-  // the energy the moving walls put in and the contacts take out
+  // a step without a solve recovers nothing (f_ID[22] 0)
   recovering_ = false;
   output_->report_split(0);
   if (solved) {
     if (substepped) follow_substeps(steps.path, steps.done, hs);
     if (every > 1) follow_solve_step(every);
     recovering_ = recover_penetrations(steps);
-    output_->add_work(steps.work);
+    output_->add_work(steps.work); // the energy the moving walls put in and the contacts take out
   }
   // the history: the last substep's impulses and (compliance material) its springs
   overflow_count_ += history_.store(found.tags, sys.contacts(), res.lambda, model.rows, hs,
