@@ -9,6 +9,7 @@
 #include "fibre/model/contact_model.hpp"
 #include "host.h"
 #include "force.h"
+#include "lammps_clumps.h"
 #include "lammps_exchange.h"
 #include "neigh_list.h"
 #include "neighbor.h"
@@ -154,6 +155,7 @@ fibre::FoundContacts LammpsDetection::contacts(const std::vector<fibre::Body> &b
     pair_contacts(bodies, h, damping, found);
     wall_contacts(bodies, h, damping, found);
   }
+  if (clumps_) clumps_->joints(bodies, atom_body_, found);
   last_found_ = found.size();
   return fibre::sort_contacts(std::move(found));
 }
@@ -223,8 +225,9 @@ void LammpsDetection::pair_contacts(const std::vector<fibre::Body> &bodies, doub
       if (bi < 0 && bj < 0) continue;
       if (impact_pass &&
           (taken_[pair] || (!(bi >= 0 && kick_[bi] > 0) && !(bj >= 0 && kick_[bj] > 0))))
-        continue;                     // the impact pass: nothing new within reach
-      if (tag[i] == tag[j]) continue; // a periodic image of itself
+        continue;                                   // the impact pass: nothing new within reach
+      if (tag[i] == tag[j]) continue;               // a periodic image of itself
+      if (clumps_ && clumps_->same(i, j)) continue; // a clump's joint holds them
       if (j >= nlocal && !newton_pair && tag[i] > tag[j]) continue;
       const double dx = x[i][0] - x[j][0], dy = x[i][1] - x[j][1], dz = x[i][2] - x[j][2];
       const double rsq = dx * dx + dy * dy + dz * dz;

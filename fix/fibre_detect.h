@@ -17,6 +17,7 @@
 namespace fibre_lmp {
 
 class LammpsExchange;
+class LammpsClumps;
 
 class LammpsDetection : protected LAMMPS_NS::Pointers {
  public:
@@ -25,6 +26,8 @@ class LammpsDetection : protected LAMMPS_NS::Pointers {
 
   // Resolves the host's walls (region or mesh IDs); call from init().
   void init_walls(const std::vector<fibre::WallSpec> &walls);
+  // Clumps (nullptr: none): no contacts within a clump, and a joint for each member.
+  void set_clumps(const LammpsClumps *clumps) { clumps_ = clumps; }
   // The pair style's materials (nullptr: none), for a JKR contact's reach beyond touching.
   void set_materials(const fibre::MaterialTable *materials);
   // At a run's setup: moving regions record their present position, so that the first step's
@@ -85,6 +88,7 @@ class LammpsDetection : protected LAMMPS_NS::Pointers {
   LammpsExchange &exchange_;
   std::vector<fibre::WallSpec> walls_;
   const fibre::MaterialTable *materials_ = nullptr; // set when some type pair is JKR
+  const LammpsClumps *clumps_ = nullptr;
   double wall_time_ = 0.0;
   std::vector<double> kick_; // per body: the speed an impact may give it this step
   // per listed pair, in the list's order: a contact of the first pass, which the impact pass

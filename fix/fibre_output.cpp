@@ -24,18 +24,21 @@ FibreOutput::~FibreOutput()
 
 double FibreOutput::count_contacts(const std::vector<fibre::Contact> &contacts)
 {
-  double sums[2] = {double(contacts.size()), 0.0};
+  // contacts, wall contacts, and every row block of the system (a clump's joints too)
+  double sums[3] = {0.0, 0.0, double(contacts.size())};
   double deepest = 0.0;
   for (const fibre::Contact &c : contacts) {
+    if (c.is_joint()) continue;
+    sums[0] += 1.0;
     if (c.is_wall()) sums[1] += 1.0;
     deepest = std::max(deepest, -c.gap);
   }
-  MPI_Allreduce(MPI_IN_PLACE, sums, 2, MPI_DOUBLE, MPI_SUM, world);
+  MPI_Allreduce(MPI_IN_PLACE, sums, 3, MPI_DOUBLE, MPI_SUM, world);
   MPI_Allreduce(MPI_IN_PLACE, &deepest, 1, MPI_DOUBLE, MPI_MAX, world);
   stats_[V_CONTACTS] = sums[0];
   stats_[V_WALL_CONTACTS] = sums[1];
   stats_[V_OVERLAP] = deepest;
-  return sums[0];
+  return sums[2];
 }
 
 void FibreOutput::report_solve(const fibre::StepResult &res)

@@ -64,8 +64,8 @@ class FibreOutput : protected LAMMPS_NS::Pointers {
                : 0.0;
   }
 
-  // Contacts, wall contacts and the deepest overlap over all processes; returns the number
-  // of contacts.
+  // Contacts, wall contacts and the deepest overlap over all processes, a clump's joints not
+  // counted; returns the number of contacts and joints (zero: free flight).
   double count_contacts(const std::vector<fibre::Contact> &contacts);
   // The solve's figures (summed or maximised over processes), with a warning at most every
   // 100 steps while solves fail. A step without contacts reports an empty, converged result.

@@ -40,6 +40,7 @@
 #include "force.h"
 #include "group.h"
 #include "host.h"
+#include "lammps_clumps.h"
 #include "lammps_exchange.h"
 #include "modify.h"
 #include "neighbor.h"
@@ -119,6 +120,15 @@ FixFibreContact::FixFibreContact(LAMMPS *lmp, int narg, char **arg) : Fix(lmp, n
   } catch (fibre::SettingsError &e) {
     fail(error, FLERR, std::string("Illegal fix fibre_contact command: ") + e.what());
   }
+  if (settings_.clumps) {
+    clumps_ = std::make_unique<fibre_lmp::LammpsClumps>(lmp, this, groupbit);
+    comm_forward = std::max(comm_forward, fibre_lmp::LammpsClumps::kValues);
+#ifdef FIBRE_HOST_LIGGGHTS
+    comm->maxexchange_fix += fibre_lmp::LammpsClumps::kValues;
+#else
+    maxexchange += fibre_lmp::LammpsClumps::kValues;
+#endif
+  }
   if (comm->me == 0)
     for (const std::string &note : settings_.notes)
       warn(error, FLERR, "Fix fibre_contact: " + note);
@@ -133,6 +143,7 @@ FixFibreContact::FixFibreContact(LAMMPS *lmp, int narg, char **arg) : Fix(lmp, n
   time_origin_ = simulated_time(); // moving planes start their motion here, as fix wall/gran's
   exchange_ = std::make_unique<fibre_lmp::LammpsExchange>(lmp, this, world);
   detection_ = std::make_unique<fibre_lmp::LammpsDetection>(lmp, groupbit, *exchange_);
+  detection_->set_clumps(clumps_.get());
   output_ = std::make_unique<FibreOutput>(lmp);
 
   // per-atom warm-start storage, migrating with the atoms and written to restart files
@@ -245,6 +256,7 @@ void FixFibreContact::init()
   if (starts_with(update->integrate_style, "respa"))
     fail(error, FLERR, "Fix fibre_contact does not support run_style respa");
   check_pair_style(true);
+  if (clumps_) clumps_->check();
   dtv_ = update->dt;
   warn_double_integration();
   fibre_lmp::warn_uncarried_fixes(lmp, id);
@@ -305,6 +317,7 @@ void FixFibreContact::initial_integrate(int /*vflag*/)
         pending_[i][d] = 0.0;
         x[i][d] += dtv_ * v[i][d];
       }
+  if (clumps_) clumps_->rotate(dtv_);
 }
 
 // Between runs the positions take the substeps' displacement in: the next run's first step
@@ -584,6 +597,7 @@ void FixFibreContact::final_integrate()
   // (compliance material: the elastic rows' penetrations are split once the contact model has
   // found them, so detection reaches further while they are recovered)
   const bool reach = !model.compliance.material || recovering_;
+  if (clumps_) clumps_->prepare(forward_clumps_);
   fibre::FoundContacts found =
       detection_->contacts(bodies, h_, model.damping, model.may_bounce() || substeps > 1,
                            reach ? hs * recovery : 0.0, recovering_);

@@ -19,6 +19,7 @@ namespace fibre_lmp {
 class LammpsExchange;
 class LammpsDetection;
 class FibreOutput;
+class LammpsClumps;
 } // namespace fibre_lmp
 
 namespace LAMMPS_NS {
@@ -126,6 +127,8 @@ class FixFibreContact : public Fix {
   std::unique_ptr<fibre_lmp::LammpsExchange> exchange_;
   std::unique_ptr<fibre_lmp::LammpsDetection> detection_;
   std::unique_ptr<fibre_lmp::FibreOutput> output_;
+  std::unique_ptr<fibre_lmp::LammpsClumps> clumps_; // clumps molecule, else null
+  bool forward_clumps_ = false;                     // the forward comm is the clumps' state
   fibre::ContactHistory history_;
   // Per atom: the substeps' displacement beyond dt v (follow_substeps), added at the next
   // step's start, so that between steps the positions are the step's own.

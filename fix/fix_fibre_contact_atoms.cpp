@@ -11,6 +11,7 @@
 #include "atom.h"
 #include "fibre_output.h"
 #include "host.h"
+#include "lammps_clumps.h"
 #include "lammps_exchange.h"
 
 using namespace LAMMPS_NS;
@@ -23,33 +24,36 @@ void FixFibreContact::grow_arrays(int nmax)
 {
   history_.grow(nmax);
   pending_.resize(std::max<std::size_t>(pending_.size(), nmax), {0.0, 0.0, 0.0});
+  if (clumps_) clumps_->grow(nmax);
 }
 
 void FixFibreContact::copy_arrays(int i, int j, int /*delflag*/)
 {
   history_.copy(i, j);
   pending_[j] = pending_[i];
+  if (clumps_) clumps_->copy(i, j);
 }
 
 void FixFibreContact::set_arrays(int i)
 {
   history_.clear(i);
   pending_[i] = {0.0, 0.0, 0.0};
+  if (clumps_) clumps_->clear(i);
 }
 
-// [the history, the pending displacement]
+// [the history, the pending displacement, the clump's state]
 int FixFibreContact::pack_exchange(int i, double *buf)
 {
   const int m = history_.pack(i, buf);
   std::copy(pending_[i].begin(), pending_[i].end(), buf + m);
-  return m + kPendingValues;
+  return m + kPendingValues + (clumps_ ? clumps_->pack(i, buf + m + kPendingValues) : 0);
 }
 
 int FixFibreContact::unpack_exchange(int nlocal, double *buf)
 {
   const int m = history_.unpack(nlocal, buf);
   std::copy(buf + m, buf + m + kPendingValues, pending_[nlocal].begin());
-  return m + kPendingValues;
+  return m + kPendingValues + (clumps_ ? clumps_->unpack(nlocal, buf + m + kPendingValues) : 0);
 }
 
 // [number of values including itself, as other fixes read it; the history; the pending
@@ -87,6 +91,7 @@ void FixFibreContact::unpack_restart(int nlocal, int nth)
   const int values = count - 2 - (pending ? kPendingValues : 0);
   history_.unpack(nlocal, extra + m + 1, values, slot);
   pending_[nlocal] = {0.0, 0.0, 0.0};
+  if (clumps_) clumps_->clear(nlocal); // set up again from the restart's positions
   if (pending)
     std::copy(extra + m + count - kPendingValues, extra + m + count, pending_[nlocal].begin());
 }
@@ -108,12 +113,16 @@ int FixFibreContact::maxsize_restart()
 int FixFibreContact::FIBRE_PACK_FORWARD(int n, int *list, double *buf, int /*pbc_flag*/,
                                         int * /*pbc*/)
 {
+  if (forward_clumps_)
+    return fibre_lmp::packed_count(clumps_->pack_forward(n, list, buf),
+                                   fibre_lmp::LammpsClumps::kValues);
   return fibre_lmp::packed_count(exchange_->pack_forward(n, list, buf),
                                  fibre_lmp::LammpsExchange::kValuesPerAtom);
 }
 
 void FixFibreContact::FIBRE_UNPACK_FORWARD(int n, int first, double *buf)
 {
+  if (forward_clumps_) return clumps_->unpack_forward(first, n, buf);
   exchange_->unpack_forward(first, n, buf);
 }
 

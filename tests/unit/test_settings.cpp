@@ -217,6 +217,10 @@ TEST(Settings, BadInputNamesTheKeywordAndItsForm)
   EXPECT_EQ(error_of("sweeps -1"), "expected 'sweeps <non-negative integer>', got '-1'");
   EXPECT_EQ(error_of("mu -0.1"), "expected 'mu <non-negative number>', got '-0.1'");
   EXPECT_EQ(error_of("rows 4"), "expected 'rows 3|6', got '4'");
+  EXPECT_EQ(error_of("clumps rigid"), "expected 'clumps molecule|none', got 'rigid'");
+  EXPECT_EQ(error_of("clumps"), "expected 'clumps molecule|none'");
+  EXPECT_TRUE(parse_settings(words("clumps molecule")).clumps);
+  EXPECT_FALSE(parse_settings(words("clumps molecule clumps none")).clumps);
   EXPECT_EQ(error_of("recovery_speed -1"),
             "expected 'recovery_speed auto|none|<positive speed>', got '-1'");
   EXPECT_EQ(error_of("restitution 1.5"), "expected 'restitution <number in [0, 1]>', got '1.5'");
@@ -334,7 +338,7 @@ TEST(Settings, OneTableOfKeywordsInTwoTiers)
     EXPECT_FALSE(tuning_seen && k.tier == KeywordTier::user) << k.name << " after a tuning one";
     EXPECT_FALSE(k.help.empty()) << k.name;
   }
-  EXPECT_EQ(all.size(), 37u);
+  EXPECT_EQ(all.size(), 38u);
   for (const char *bad : {"tol -1", "linear_tol 0", "anderson 99", "substep_when rest"}) {
     const std::vector<std::string> w = words(bad);
     const auto k =

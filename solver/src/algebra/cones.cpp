@@ -28,7 +28,18 @@ Cones Cones::frictionless(const ContactSystem &sys)
 {
   Cones cones(sys);
   std::fill(cones.coeff_.begin(), cones.coeff_.end(), 0.0);
-  cones.pull_.clear();
+  // a joint stays bilateral: the recovery moves a clump as one body
+  bool joints = false;
+  for (int c = 0; c < sys.num_contacts(); ++c) {
+    if (!sys.contacts()[c].is_joint()) {
+      if (!cones.pull_.empty()) cones.pull_[c] = 0.0;
+      continue;
+    }
+    joints = true;
+    for (int cone = 0; cone < num_cones(cones.rows_); ++cone)
+      cones.coeff_[3 * std::size_t(c) + cone] = 1.0;
+  }
+  if (!joints) cones.pull_.clear();
   return cones;
 }
 

@@ -63,8 +63,9 @@ Vector spook_rhs(const ContactSystem &sys, const Vector *extra_dv)
     const std::array<double, kMaxRows> wall = wall_rows(k);
     if (k.wall_moves())
       for (int r = 0; r < rows; ++r) b[row + r] += (1.0 - ups_r[r]) * wall[r];
+    const int joint_rows = k.is_joint() ? 3 : 1; // a joint's t1, t2 carry its error
     for (int r = 1; r < rows; ++r)
-      if (k.elastic[r] && sys.row_active(row + r))
+      if ((k.elastic[r] || r < joint_rows) && sys.row_active(row + r))
         b[row + r] += p.spring_term(k.spring[r], ups_r[r]);
     if (!sys.row_active(row)) continue;
     const double b_spook = b[row] + p.gap_term(k, ups_c);
@@ -162,6 +163,10 @@ std::vector<std::array<double, kMaxRows>> advance_springs(const ContactSystem &s
     const std::array<double, kMaxRows> wall = sys.walls_move() ? wall_rows(k) : at_rest;
     if (k.penetration > 0) // what is left of it at the step's end (row 0: no spring)
       springs[c][0] = std::min(k.penetration, std::max(0.0, -(k.gap + h * (Gv[base] - wall[0]))));
+    if (k.is_joint()) { // its error at the step's end (joint_contact)
+      for (int r = 1; r < 3; ++r) springs[c][r] = k.spring[r] + h * Gv[base + r];
+      continue;
+    }
     if (!k.any_elastic()) continue;
     const double lambda_n = lambda.size() == sys.contact_dofs()
                                 ? std::max(cone_load(lambda[base], h * k.pull), 0.0)

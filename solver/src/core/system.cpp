@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <atomic>
 #include <cmath>
+#include <limits>
 #include <stdexcept>
 #include <string>
 
@@ -57,6 +58,24 @@ Contact sphere_wall_contact(const std::vector<Body> &bodies, int a, const Vec3 &
   tangent_frame(c.normal, c.t1, c.t2);
   c.gap = distance - A.radius;
   c.point = A.x - c.normal * (A.radius + 0.5 * c.gap);
+  return c;
+}
+
+Contact joint_contact(const std::vector<Body> &bodies, int a, int b, const Vec3 &axis,
+                      const Vec3 &error)
+{
+  Contact c;
+  c.a = a;
+  c.b = b;
+  const double length = axis.norm();
+  c.normal = length > 0 ? Vec3(axis / length) : Vec3::UnitZ();
+  tangent_frame(c.normal, c.t1, c.t2);
+  c.point = bodies.at(a).x;
+  c.gap = c.normal.dot(error);
+  c.spring[1] = c.t1.dot(error);
+  c.spring[2] = c.t2.dot(error);
+  c.pull = std::numeric_limits<double>::infinity();
+  c.friction = {1.0, 1.0, 1.0};
   return c;
 }
 
@@ -184,7 +203,8 @@ void ContactSystem::compute_rows()
 
 void ContactSystem::set_friction(const FrictionParams &f)
 {
-  for (Contact &c : contacts_) c.friction = f;
+  for (Contact &c : contacts_)
+    if (!c.is_joint()) c.friction = f; // a joint's cones stay unbounded
 }
 
 void ContactSystem::set_row_mask(const std::vector<unsigned char> &active)

@@ -345,6 +345,14 @@ std::vector<Keyword> run_keywords()
          st.s.contact_every = in.at(i + 1) == "auto" ? 0 : count(in, i + 1, e, 1, 1000000);
          return 2;
        }},
+      {{"clumps", U, "'clumps molecule|none'",
+        "the spheres of one molecule move as one rigid body"},
+       [](const Reader &in, std::size_t i, const std::string &e, ParseState &st) -> std::size_t {
+         if (!in.has(i + 1) || (in.at(i + 1) != "molecule" && in.at(i + 1) != "none"))
+           Reader::illegal(e, in.has(i + 1) ? &in.at(i + 1) : nullptr);
+         st.s.clumps = in.at(i + 1) == "molecule";
+         return 2;
+       }},
       {{"check", U, "'check <N>' (N a non-negative integer)",
         "every N steps, the step's error against the converged step"},
        [](const Reader &in, std::size_t i, const std::string &e, ParseState &st) -> std::size_t {
@@ -687,6 +695,7 @@ std::string describe(const Settings &s)
     out += ", contact_every " +
            (s.contact_every > 0 ? std::to_string(s.contact_every)
                                 : "auto (at most " + format_g(kEveryCollisions) + " t_c a solve)");
+  if (s.clumps) out += ", clumps molecule";
   const FrictionParams &f = s.model.friction;
   return out + ", mu " + format_g(f.mu) + ", mu_roll " + format_g(f.mu_roll) + ", mu_twist " +
          format_g(f.mu_twist);

@@ -87,6 +87,7 @@ void ContactHistory::load_springs(const std::vector<ContactTag> &tags,
 {
   for (std::size_t c = 0; c < tags.size(); ++c) {
     Contact &k = contacts[c];
+    if (k.is_joint()) continue; // its error is its own (joint_contact)
     k.spring.fill(0.0);
     k.penetration = 0.0;
     k.split = false;

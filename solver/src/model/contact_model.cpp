@@ -261,6 +261,16 @@ void apply_pair(const ContactModel &model, const PairCoefficients &pc, const Spo
   }
 }
 
+// A joint's rows, rigid (kJointCompliance) on the two spheres' inverse masses and inertias.
+void hold_joint(const std::vector<Body> &bodies, double h, Contact &c)
+{
+  const Body &a = bodies[c.a], &b = bodies[c.b];
+  const double w_t = 1.0 / a.mass + 1.0 / b.mass;
+  const double w_r = 2.5 / (a.mass * a.radius * a.radius) + 2.5 / (b.mass * b.radius * b.radius);
+  for (int r = 0; r < kMaxRows; ++r)
+    c.compliance[r] = kJointCompliance * h * h * (r < 3 ? w_t : w_r);
+}
+
 } // namespace
 
 void apply_contact_model(const ContactModel &model, const SpookParams &params, double m_min,
@@ -277,6 +287,10 @@ void apply_contact_model(const ContactModel &model, const SpookParams &params, d
     c.compliance[0] = eps_n;
     c.compliance[1] = c.compliance[2] = eps_t;
     for (int r = 3; r < kMaxRows; ++r) c.compliance[r] = eps_t / (reff * reff);
+    if (c.is_joint()) { // rigid, bilateral, its error its own (joint_contact)
+      hold_joint(bodies, h, c);
+      continue;
+    }
     c.friction = model.friction;
     c.restitution = model.restitution;
     c.elastic.fill(false);

@@ -28,6 +28,8 @@ Vector recovery_rhs(const ContactSystem &sys, const Vector &Gv, double span)
     const double left = k.elastic[0] ? std::min(k.penetration, -gap) : -gap;
     if (p.split_penetration(k))
       b[row] = std::min(std::max(left, 0.0) / span, p.max_recovery);
+    else if (k.is_joint()) // a clump moves as one body
+      b[row] = 0.0;
     else
       b[row] = std::min(-gap / span, 0.0);
   }

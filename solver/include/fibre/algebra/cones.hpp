@@ -42,7 +42,8 @@ inline void set_cone(Vector &v, Eigen::Index base, const Cone &cone, const Eigen
 class Cones {
  public:
   explicit Cones(const ContactSystem &sys); // coefficients from each contact's friction
-  // lambda_n >= 0 alone: every coefficient zero, no cohesion (the split recovery's problem)
+  // lambda_n >= 0 alone: every coefficient zero, no cohesion (the split recovery's problem); joints
+  // stay bilateral
   static Cones frictionless(const ContactSystem &sys);
   int rows() const { return rows_; }
   // Whether some contact is cohesive (Contact::pull): its lambda_n may be negative.

@@ -7,6 +7,7 @@
 
 #include <Eigen/Dense>
 #include <array>
+#include <cmath>
 #include <cstdint>
 #include <utility>
 #include <vector>
@@ -132,6 +133,8 @@ struct Contact {
     return false;
   }
   bool is_wall() const { return b < 0; }
+  // A joint (joint_contact): its pull is infinite, so that every row is bilateral.
+  bool is_joint() const { return std::isinf(pull); }
   bool wall_moves() const
   {
     return b < 0 && (wall_v != Vec3::Zero() || wall_omega != Vec3::Zero());
@@ -172,6 +175,16 @@ void sphere_sphere_gap(const Body &a, const Body &b, Vec3 &normal, double &gap);
 // `distance` is the centre's distance from the wall surface along it.
 Contact sphere_wall_contact(const std::vector<Body> &bodies, int a, const Vec3 &normal,
                             double distance);
+
+// A lock joint of a clump (rigid spheres held together): body a, a member, to body b, its hub,
+// at a's centre. Every row is bilateral (pull = infinity: the cones bound nothing), rows n, t1,
+// t2 hold a's centre on the hub and rows 3..5 turn both alike. `axis` is the member's rest
+// offset from the hub, turned with the hub (its frame's normal: the rows keep their directions
+// from step to step, and so do their warm starts); `error` is how far a's centre is from where
+// the hub holds it. The normal row's gap and t1, t2's spring carry the error's components, so
+// that SPOOK's stabilization removes it within a few steps (spook_rhs).
+Contact joint_contact(const std::vector<Body> &bodies, int a, int b, const Vec3 &axis,
+                      const Vec3 &error);
 
 // Per-contact kinematics: G_a w_a = [D (v_a + omega_a x ra) ; D omega_a] with D the frame
 // (rows n, t1, t2); G_b the same with minus sign and rb. This is thesis eq. 2.1.1 written

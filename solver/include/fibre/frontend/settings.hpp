@@ -24,6 +24,9 @@ struct Settings {
   // Solve the contacts every N steps, each solve over the N steps to the next (its impulses
   // applied at once, the external forces every step); 0: auto (steps_per_solve).
   int contact_every = 1;
+  // Clumps: the spheres of one molecule (a nonzero molecule ID) move as one rigid body, held by
+  // lock joints (joint_contact); contacts within a clump are not detected.
+  bool clumps = false;
   // For the log: typed tuning keywords that have no effect under these settings, and
   // deprecated ones.
   std::vector<std::string> notes;
