@@ -103,7 +103,7 @@ int LammpsClumps::hub_of(int i) const
     fail_one(error, FLERR,
              "Fix fibre_contact clumps: atom " + std::to_string(atom->tag[i]) +
                  " cannot see its clump's first atom " + std::to_string(hub) +
-                 " (comm_modify cutoff must reach across a clump)");
+                 " (lost, or beyond the halo: comm_modify cutoff must reach across a clump)");
   return domain->closest_image(i, j);
 }
 

@@ -86,6 +86,9 @@ Substeps run_substeps(int n, const ContactModel &model, const SpookParams &param
                 c[k].spring = springs[k];
                 c[k].penetration = springs[k][0];
                 c[k].spring[0] = 0.0;
+              } else if (c[k].is_joint()) { // its error, as advance_springs's
+                for (int r = 1; r < 3; ++r)
+                  c[k].spring[r] += h * Gv[Eigen::Index(rows) * Eigen::Index(k) + r];
               }
             }
             for (std::size_t i = 0; i < b.size(); ++i) {
