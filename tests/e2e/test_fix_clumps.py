@@ -27,9 +27,8 @@ processes:
 - errors: no molecule IDs, or a bad value, name the keyword.
 """
 
-import os
-
 import math
+import os
 
 import fibre_e2e as e2e
 
@@ -38,19 +37,24 @@ DT = 0.01
 T1_STEP, T2_STEP = 200, 1000
 
 
+def clump_opening(box, spheres, cutoff, boundary="f f f", processors=None,
+                  law="gran/hooke 1.0 NULL 0.0 NULL 0.0 0", coeff="", dt=DT):
+    """The deck's lines up to the step: unit spheres at `spheres` (x, y, z), all of molecule 1
+    (fix property/atom), a halo of `cutoff` that reaches across the clump, the pair style."""
+    lines = e2e.sphere_box(box, boundary=boundary, processors=processors)
+    lines[4] = "comm_modify vel yes cutoff %g" % cutoff
+    lines.insert(1, "fix prop all property/atom mol ghost yes")
+    lines += ["create_atoms 1 single %g %g %g units box" % p for p in spheres]
+    return lines + ["set atom * diameter 1.0 density 1.0", "set atom * mol 1",
+                    "pair_style " + law, "pair_coeff * * " + coeff, "neighbor 0.2 bin",
+                    "timestep %g" % dt]
+
+
 def dumbbell_deck(spheres, mu, processors=None):
     t = math.radians(THETA)
-    lines = e2e.sphere_box("-10 10 -3 3 0 5", boundary="p p f", processors=processors)
-    lines[4] = "comm_modify vel yes cutoff 2.5"  # the halo reaches across a clump
-    lines.insert(1, "fix prop all property/atom mol ghost yes")
-    lines += ["create_atoms 1 single %g %g 0.5 units box" % xy for xy in spheres]
+    lines = clump_opening("-10 10 -3 3 0 5", [(x, y, 0.5) for x, y in spheres], 2.5,
+                          boundary="p p f", processors=processors)
     return "\n".join(lines + [
-        "set atom * diameter 1.0 density 1.0",
-        "set atom * mol 1",
-        "pair_style gran/hooke 1.0 NULL 0.0 NULL 0.0 0",
-        "pair_coeff * *",
-        "neighbor 0.2 bin",
-        "timestep %g" % DT,
         "fix g all gravity 1.0 vector %.17g 0 %.17g" % (math.sin(t), -math.cos(t)),
         "fix fc all fibre_contact wall zplane 0.0 NULL mu %g clumps molecule" % mu,
         "compute p all property/atom xu vx omegay",
@@ -68,18 +72,10 @@ OMEGA = (0.3, 0.2, 1.0)
 
 
 def tumbling_deck(steps, processors=None):
-    lines = e2e.sphere_box("-10 10 -10 10 -10 10", processors=processors)
-    lines[4] = "comm_modify vel yes cutoff 3.0"
-    lines.insert(1, "fix prop all property/atom mol ghost yes")
-    lines += ["create_atoms 1 single %g %g 0 units box" % xy for xy in L_SPHERES]
+    lines = clump_opening("-10 10 -10 10 -10 10", [(x, y, 0) for x, y in L_SPHERES], 3.0,
+                          processors=processors)
     wx, wy, wz = OMEGA
     return "\n".join(lines + [
-        "set atom * diameter 1.0 density 1.0",
-        "set atom * mol 1",
-        "pair_style gran/hooke 1.0 NULL 0.0 NULL 0.0 0",
-        "pair_coeff * *",
-        "neighbor 0.2 bin",
-        "timestep %g" % DT,
         # the rigid motion omega about the centre of mass
         "variable vx atom %.17g*z-%.17g*(y-0.75)" % (wy, wz),
         "variable vy atom %.17g*(x-0.25)-%.17g*z" % (wz, wx),
@@ -213,20 +209,12 @@ def check_restart(args, ck, uninterrupted):
 
 
 def drop_deck(processors=None):
-    lines = e2e.sphere_box("-10 10 -10 10 -1 20", processors=processors)
-    lines[4] = "comm_modify vel yes cutoff 3.0"
-    lines.insert(1, "fix prop all property/atom mol ghost yes")
-    lines += ["create_atoms 1 single %g %g %g units box" % p
-              for p in [(0, 0, 3), (0.8, 0.3, 3.5), (-0.7, 0.5, 3.4)]]
+    lines = clump_opening("-10 10 -10 10 -1 20", [(0, 0, 3), (0.8, 0.3, 3.5), (-0.7, 0.5, 3.4)],
+                          3.0, processors=processors, law="granular",
+                          coeff="hertz/material 1e5 0.3 0.3 tangential mindlin NULL 1.0 0.5 "
+                          "damping tsuji", dt=0.001)
     return "\n".join(lines + [
-        "set atom * diameter 1.0 density 1.0",
-        "set atom * mol 1",
         "velocity all set 0.5 0 0",
-        "pair_style granular",
-        "pair_coeff * * hertz/material 1e5 0.3 0.3 tangential mindlin NULL 1.0 0.5 "
-        "damping tsuji",
-        "neighbor 0.2 bin",
-        "timestep 0.001",
         "fix g all gravity 9.81 vector 0 0 -1",
         "fix fc all fibre_contact wall zplane 0.0 NULL clumps molecule",
         "compute er all erotate/sphere",
