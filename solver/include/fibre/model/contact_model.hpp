@@ -112,11 +112,11 @@ inline constexpr double kRoundoffLoad = 1e-9;
 // penetration is split when found beyond kPenetrationStart steps and stays split down to
 // kPenetrationFloor (Contact::split).
 inline constexpr double kPenetrationStart = 10.0;
+inline constexpr double kPenetrationFloor = 0.01;
 // A joint's compliance, h^2 times this of its rows' inverse mass (its Sigma about 1e-7 of
 // G M^-1 G^T): rigid whatever the material. At the material's own compliance (the incline test's
 // soft gran/hooke 1.0) a clump held on a slope by friction crept at 2% of g h a step.
 inline constexpr double kJointCompliance = 1e-6;
-inline constexpr double kPenetrationFloor = 0.01;
 
 // Contact c's bodies' approach speed along the normal (> 0 closing; a wall at its own
 // velocity).
