@@ -5,6 +5,7 @@
 #include <cmath>
 #include <vector>
 
+#include "fibre/algebra/assembly.hpp"
 #include "fibre/algebra/cones.hpp"
 #include "fibre/algebra/spook.hpp"
 #include "fibre/solvers/pgs.hpp"
@@ -107,4 +108,45 @@ TEST(Joints, TheConesLeaveAJointUnbounded)
   Cones::frictionless(sys).project(m, 1);
   EXPECT_EQ(m[0], 0.0);
   for (int r = 1; r < 6; ++r) EXPECT_EQ(m[r], 0.0) << r;
+}
+
+// A clump's joints are one block of the sweeps (joint_blocks.hpp), solved exactly: on a system
+// of one clump alone, one sweep gives the impulses of the dense solve of
+// (G M^-1 G^T + Sigma) lambda = b, whatever the members' masses, offsets and errors.
+TEST(Joints, OneSweepSolvesAClumpsJointsExactly)
+{
+  std::vector<Body> bodies(5);
+  const Vec3 at[5] = {
+      {0.3, -0.2, 0.1}, {1.3, 0.0, 0.1}, {0.2, 0.9, 0.0}, {-0.7, 0.1, 0.4}, {0.5, -0.6, 1.1}};
+  for (int i = 0; i < 5; ++i) {
+    bodies[i].x = at[i];
+    bodies[i].radius = 0.4 + 0.05 * i;
+    bodies[i].mass = 0.7 + 0.3 * i;
+    bodies[i].force = Vec3(0.1 * i, -1.0, 0.2);
+    bodies[i].torque = Vec3(0.0, 0.05 * i, -0.03);
+  }
+  SpookParams params;
+  params.h = 1e-2;
+  std::vector<Contact> contacts;
+  for (int m = 1; m < 5; ++m) {
+    const Vec3 error(0.01 * m, -0.004, 0.002 * m);
+    contacts.push_back(joint_contact(bodies, m, 0, at[m] - at[0], error));
+    contacts.back().compliance.fill(1e-8);
+  }
+  const ContactSystem sys(bodies, contacts, 6, params);
+  const Vector b = spook_rhs(sys);
+  const Eigen::MatrixXd A(assemble_A(sys));
+  const Vector exact = A.ldlt().solve(b);
+  Vector lambda = Vector::Zero(sys.contact_dofs());
+  const PgsResult r =
+      pgs(sys, serial_exchange(), Cones(sys), b, row_scales(sys), lambda, PgsControl{1, 0.0, 1000});
+  EXPECT_EQ(r.sweeps, 1);
+  EXPECT_LT((lambda - exact).norm(), 1e-10 * exact.norm()) << (lambda - exact).norm();
+  // without the block (its joints swept one at a time, as without six rows) one sweep is far off
+  Vector one_at_a_time = Vector::Zero(sys.contact_dofs());
+  for (int c = 0; c < sys.num_contacts(); ++c) {
+    const Eigen::MatrixXd Acc = A.block(6 * c, 6 * c, 6, 6);
+    one_at_a_time.segment<6>(6 * c) = Acc.ldlt().solve(Vector(b.segment<6>(6 * c)));
+  }
+  EXPECT_GT((one_at_a_time - exact).norm(), 1e-2 * exact.norm());
 }

@@ -12,6 +12,7 @@
 #include "fibre/algebra/spook.hpp"
 #include "fibre/precond/fibre_blocks.hpp"
 #include "fibre/solvers/anderson.hpp"
+#include "fibre/solvers/joint_blocks.hpp"
 #include "fibre/solvers/sweep_groups.hpp"
 
 namespace fibre {
@@ -208,6 +209,7 @@ class PgsRun {
         anderson_(std::max(control.anderson, 1), ex), period_(std::max(control.anderson_period, 1))
   {
     layout(scale);
+    block_joints();
     // the blocks read their bound rows from feasible impulses
     if (control_.fibre_blocks)
       for (int c = 0; c < nc_; ++c) cones_.project(lambda_.data() + Eigen::Index(rows_) * c, c);
@@ -251,9 +253,11 @@ class PgsRun {
   static constexpr int kCheckpointSweeps = 16;
 
   void layout(const std::vector<Vec6> &scale);
+  void block_joints();
   void prepare_groups();
   void keep_start();
-  void sweep_and_sum(const int *visit, int n, GroupedSweep *group, double *norms, double *changes);
+  void sweep_and_sum(const int *visit, int n, GroupedSweep *group, const JointBlocks *joints,
+                     double *norms, double *changes);
   bool sweep(int s);
   bool stop_rule(bool full, const double *norms);
   bool stalled();
@@ -274,6 +278,10 @@ class PgsRun {
   BodyShares shares_;
   std::vector<std::vector<int>> phases_;
   bool coloured_ = false;
+  // the clumps' joints in blocks, per phase (one without colours), and without colours the
+  // contacts the full sweeps visit one at a time or in groups (the rest)
+  std::vector<JointBlocks> joints_;
+  std::vector<int> free_;
   Vector split_inv_mass_;
   std::vector<Vec6> inv_scale_;
   const double *inv_mass_ = nullptr;
@@ -342,6 +350,26 @@ void PgsRun::layout(const std::vector<Vec6> &scale)
   inv_mass_ = split.size() ? split_inv_mass_.data() : sys_.inv_mass().data();
 }
 
+// The clumps' joints in blocks (joint_blocks.hpp), out of each phase's or the full sweeps' lists
+void PgsRun::block_joints()
+{
+  const std::vector<Contact> &contacts = sys_.contacts();
+  if (std::none_of(contacts.begin(), contacts.end(), [](const Contact &k) { return k.is_joint(); }))
+    return;
+  if (coloured_) {
+    for (std::vector<int> &phase : phases_) {
+      joints_.emplace_back(sys_, ex_.local_owners(), inv_mass_, &phase);
+      phase = joints_.back().others();
+    }
+    return;
+  }
+  joints_.emplace_back(sys_, ex_.local_owners(), inv_mass_, nullptr);
+  if (joints_.back().empty())
+    joints_.clear();
+  else
+    free_ = joints_.back().others();
+}
+
 // Four contacts at a time where the processor can (sweep_groups.hpp): the full sweeps, or each
 // colour phase; not the focused sweeps' lists (kept in control.cache while the kinematics hold:
 // the same contacts, phases and masses)
@@ -365,7 +393,8 @@ void PgsRun::prepare_groups()
                                                            ex_.local_owners(), &phase));
       else
         grouped.push_back(std::make_unique<GroupedSweep>(sys_, cones_, b_, inv_mass_, inv_scale_,
-                                                         ex_.local_owners()));
+                                                         ex_.local_owners(),
+                                                         joints_.empty() ? nullptr : &free_));
       if (control_.cache) {
         control_.cache->kinematics = sys_.row_mask().empty() ? sys_.kinematics_id() : 0;
         control_.cache->split_masses = split;
@@ -388,8 +417,8 @@ void PgsRun::keep_start()
 
 // Every process's updates on every body: the sum of the local changes, owners and ghosts (each
 // copy's change at the body's own mass); with colours after each colour's phase.
-void PgsRun::sweep_and_sum(const int *visit, int n, GroupedSweep *group, double *norms,
-                           double *changes)
+void PgsRun::sweep_and_sum(const int *visit, int n, GroupedSweep *group, const JointBlocks *joints,
+                           double *norms, double *changes)
 {
   if (group) {
     group->sweep(lambda_, dv_, norms);
@@ -402,6 +431,7 @@ void PgsRun::sweep_and_sum(const int *visit, int n, GroupedSweep *group, double 
   else
     fibre::sweep<3>(sys_, cones_, b_, inv_mass_, inv_scale_, ex_.local_owners(), visit, n, lambda_,
                     dv_, norms, changes);
+  if (joints) joints->solve(b_, lambda_, dv_, norms);
   if (!halo_) return;
   const Vector &split = shares_.split;
   if (!halo_bodies_) {
@@ -434,8 +464,10 @@ bool PgsRun::sweep(int s)
   const bool full =
       !focus_ || s == 0 ||
       ((s + 1 - control_.min_sweeps) % focus_period + focus_period) % focus_period == 0;
-  const int *list = full ? nullptr : focus_contacts_.data();
-  const int count = full ? nc_ : static_cast<int>(focus_contacts_.size());
+  const bool blocked = !joints_.empty() && !coloured_; // the full sweeps visit free_
+  const int *list = full ? (blocked ? free_.data() : nullptr) : focus_contacts_.data();
+  const int count = full ? (blocked ? static_cast<int>(free_.size()) : nc_)
+                         : static_cast<int>(focus_contacts_.size());
   double *changes = full && focus_ ? contact_changes_.data() : nullptr;
   // Anderson: plain sweeps up to the floor (steps that it ends pay nothing), the history from
   // its last sweep on, a mix after every `period` sweeps
@@ -448,10 +480,12 @@ bool PgsRun::sweep(int s)
     for (std::size_t p = 0; p < phases_.size(); ++p) {
       if (p > 0) keep_start(); // the first phase starts where the sweep does
       sweep_and_sum(phases_[p].data(), static_cast<int>(phases_[p].size()),
-                    grouped.empty() ? nullptr : grouped[p].get(), norms, changes);
+                    grouped.empty() ? nullptr : grouped[p].get(),
+                    joints_.empty() ? nullptr : &joints_[p], norms, changes);
     }
   } else {
-    sweep_and_sum(list, count, grouped.empty() ? nullptr : grouped[0].get(), norms, changes);
+    sweep_and_sum(list, count, grouped.empty() ? nullptr : grouped[0].get(),
+                  blocked ? &joints_[0] : nullptr, norms, changes);
   }
   if (changes) focus_list(contact_changes_, norms[0], focus_contacts_);
   res_.visits += count;
