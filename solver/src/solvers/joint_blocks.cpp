@@ -54,23 +54,21 @@ JointBlocks::JointBlocks(const ContactSystem &sys, const std::vector<int> &owner
 }
 
 // Each joint's D_j and U_j from unit impulses and velocities, then the hub's response. False
-// where the joints share a member (D is then not block diagonal) or an inverse is not finite.
+// where the joints share a member, a D_j is not diagonal (the block is then not the sum above) or
+// an inverse is not finite.
 bool JointBlocks::factor_block(Block &block, const std::vector<int> &joints) const
 {
   block.hub = owner_of(owners_, sys_.contacts()[joints[0]].b);
   const Vec6 hub_inv_mass(inv_mass_ + kRows * std::size_t(block.hub));
-  std::vector<int> members;
   Mat6 hub_matrix = Mat6::Zero(); // sum_j U_j^T D_j^-1 U_j
-  bool finite = true;
+  const double zero[kRows] = {0, 0, 0, 0, 0, 0};
   for (const int c : joints) {
     const int a = owner_of(owners_, sys_.contacts()[c].a);
-    if (a == block.hub || std::find(members.begin(), members.end(), a) != members.end())
-      return false;
-    members.push_back(a);
+    for (const Joint &other : block.joints)
+      if (other.member == a) return false;
+    if (a == block.hub) return false;
     const double *q = rows_of(sys_, c);
-    Joint joint{c, Mat6::Zero(), Mat6::Zero(), Mat6::Zero()};
-    Mat6 member;
-    const double zero[kRows] = {0, 0, 0, 0, 0, 0};
+    Mat6 member, hub_rows;
     for (int i = 0; i < kRows; ++i) {
       double unit[kRows] = {0, 0, 0, 0, 0, 0}, ya[kRows] = {0, 0, 0, 0, 0, 0};
       unit[i] = 1.0;
@@ -78,63 +76,64 @@ bool JointBlocks::factor_block(Block &block, const std::vector<int> &joints) con
       for (int d = 0; d < kRows; ++d) ya[d] *= inv_mass_[kRows * std::size_t(a) + d];
       contact_velocity<kRows>(q, q + 9, q + 12, ya, nullptr, member.col(i).data());
       member(i, i) += sys_.sigma()[kRows * Eigen::Index(c) + i];
-      contact_velocity<kRows>(q, q + 9, q + 12, zero, unit, joint.hub_rows.col(i).data());
+      contact_velocity<kRows>(q, q + 9, q + 12, zero, unit, hub_rows.col(i).data());
     }
-    joint.member = member.inverse();
-    joint.reduced = joint.member * joint.hub_rows;
-    hub_matrix += joint.hub_rows.transpose() * joint.reduced;
-    finite = finite && joint.reduced.allFinite();
+    const Vec6 diagonal = member.diagonal();
+    if ((member - Mat6(diagonal.asDiagonal())).cwiseAbs().maxCoeff() >
+        1e-12 * diagonal.cwiseAbs().maxCoeff())
+      return false;
+    const Joint joint{c, a, diagonal.cwiseInverse()};
+    hub_matrix += hub_rows.transpose() * joint.member_inverse.asDiagonal() * hub_rows;
+    if (!joint.member_inverse.allFinite()) return false;
     block.joints.push_back(joint);
   }
   const Mat6 hub = Mat6::Identity() + hub_inv_mass.asDiagonal() * hub_matrix;
   block.hub_response = hub.inverse() * hub_inv_mass.asDiagonal();
-  return finite && block.hub_response.allFinite();
+  return block.hub_response.allFinite();
 }
 
+// Per block: the members' answers y_j = D_j^-1 r_j, the hub's velocity change dw from
+// sum_j U_j^T y_j, then each joint's impulse change y_j - D_j^-1 U_j dw.
 void JointBlocks::solve(const Vector &b, Vector &lambda, Vector &dv, double norms[2]) const
 {
   const double *sigma = sys_.sigma().data();
   double *w = dv.data();
-  std::vector<Vec6> delta;
+  const double zero[kRows] = {0, 0, 0, 0, 0, 0};
+  std::vector<Vec6> y;
   for (const Block &block : blocks_) {
-    // the members' answers y_j = D_j^-1 r_j, the hub's velocity change, then each joint's
-    delta.resize(block.joints.size());
-    Vec6 t = Vec6::Zero();
+    y.resize(block.joints.size());
+    double *w_hub = w + kRows * std::size_t(block.hub);
+    double t[kRows] = {0, 0, 0, 0, 0, 0}, unused[kRows] = {0, 0, 0, 0, 0, 0};
     for (std::size_t j = 0; j < block.joints.size(); ++j) {
       const Joint &joint = block.joints[j];
       const double *q = rows_of(sys_, joint.contact);
       double u[kRows];
-      contact_velocity<kRows>(q, q + 9, q + 12, w + kRows * std::size_t(member_of(joint)),
-                              w + kRows * std::size_t(block.hub), u);
+      contact_velocity<kRows>(q, q + 9, q + 12, w + kRows * std::size_t(joint.member), w_hub, u);
       const std::size_t at = kRows * std::size_t(joint.contact);
-      Vec6 r;
-      for (int i = 0; i < kRows; ++i) r[i] = b[at + i] - u[i] - sigma[at + i] * lambda[at + i];
-      delta[j].noalias() = joint.member * r;
-      t.noalias() += joint.hub_rows.transpose() * delta[j];
+      for (int i = 0; i < kRows; ++i)
+        y[j][i] = joint.member_inverse[i] * (b[at + i] - u[i] - sigma[at + i] * lambda[at + i]);
+      contact_impulse<kRows>(q, q + 9, q + 12, y[j].data(), unused, t); // t += U_j^T y_j
     }
-    const Vec6 hub_dv = block.hub_response * t;
+    const Vec6 dw = block.hub_response * Eigen::Map<const Vec6>(t);
     for (std::size_t j = 0; j < block.joints.size(); ++j) {
       const Joint &joint = block.joints[j];
-      delta[j].noalias() -= joint.reduced * hub_dv;
+      const double *q = rows_of(sys_, joint.contact);
+      double u[kRows], delta[kRows], ya[kRows] = {0, 0, 0, 0, 0, 0};
+      contact_velocity<kRows>(q, q + 9, q + 12, zero, dw.data(), u); // U_j dw
       const std::size_t at = kRows * std::size_t(joint.contact);
       for (int i = 0; i < kRows; ++i) {
-        lambda[at + i] += delta[j][i];
-        norms[0] += delta[j][i] * delta[j][i];
+        delta[i] = y[j][i] - joint.member_inverse[i] * u[i];
+        lambda[at + i] += delta[i];
+        norms[0] += delta[i] * delta[i];
         norms[1] += lambda[at + i] * lambda[at + i];
       }
-      double ya[kRows] = {0, 0, 0, 0, 0, 0};
-      const double *q = rows_of(sys_, joint.contact);
-      contact_impulse<kRows>(q, q + 9, q + 12, delta[j].data(), ya, nullptr);
-      const std::size_t a = kRows * std::size_t(member_of(joint));
-      for (int d = 0; d < kRows; ++d) w[a + d] += inv_mass_[a + d] * ya[d];
+      contact_impulse<kRows>(q, q + 9, q + 12, delta, ya, nullptr);
+      double *w_member = w + kRows * std::size_t(joint.member);
+      const double *m = inv_mass_ + kRows * std::size_t(joint.member);
+      for (int d = 0; d < kRows; ++d) w_member[d] += m[d] * ya[d];
     }
-    for (int d = 0; d < kRows; ++d) w[kRows * std::size_t(block.hub) + d] += hub_dv[d];
+    for (int d = 0; d < kRows; ++d) w_hub[d] += dw[d];
   }
-}
-
-int JointBlocks::member_of(const Joint &joint) const
-{
-  return owner_of(owners_, sys_.contacts()[joint.contact].a);
 }
 
 } // namespace fibre

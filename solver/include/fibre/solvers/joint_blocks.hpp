@@ -7,8 +7,8 @@
 // block's rows. Every joint of a block shares the hub and no other body, so that matrix is
 // block diagonal (each joint's member and Sigma) plus the hub's part, U W U^T (U the rows of the
 // hub, W its inverse mass): the solve takes the hub's velocity change from a 6x6 system and each
-// joint's impulse from its member's 6x6 inverse (Woodbury), fixed-size work where a dense factor of
-// order 6 per joint spent most of a heap's step in its triangular solves.
+// joint's impulse from its member's diagonal (Woodbury): a few dozen numbers a joint, where a
+// dense factor of order 6 a joint spent most of a heap's step in its triangular solves.
 #pragma once
 
 #include <Eigen/Dense>
@@ -23,8 +23,8 @@ class JointBlocks {
   // The joints among `list` (every contact where null) in blocks, one per hub (a joint's body
   // b; a periodic image counts as its body, `owners` as Exchange::local_owners), with the
   // sweeps' inverse masses (pgs.cpp's, split where bodies are shared). Only for six rows a
-  // contact and no masked row; a block that cannot be inverted stays out (its joints are swept
-  // one at a time).
+  // contact and no masked row; a block that does not have this structure or cannot be inverted
+  // stays out (its joints are swept one at a time).
   JointBlocks(const ContactSystem &sys, const std::vector<int> &owners, const double *inv_mass,
               const std::vector<int> *list);
   bool empty() const { return blocks_.empty(); }
@@ -35,13 +35,14 @@ class JointBlocks {
   void solve(const Vector &b, Vector &lambda, Vector &dv, double norms[2]) const;
 
  private:
-  // Joint j's member part D_j = G_a M_a^-1 G_a^T + Sigma_j, inverted (it is the member's
-  // inverse mass in the joint's frame: well conditioned), U_j and D_j^-1 U_j. Explicit
-  // inverses: the sweeps apply them tens of times a step, where Eigen's fixed-size Cholesky
-  // solve took most of a heap's step.
+  // Joint j's member part D_j = G_a M_a^-1 G_a^T + Sigma_j is diagonal (the joint's point is
+  // the member's centre, a sphere's inverse mass is isotropic and the frame orthonormal): its
+  // inverse is six numbers, and U_j is applied in its structured form (contact_rows.hpp). The
+  // sweeps visit every joint tens of times a step, and a dense 6x6 inverse and two 6x6
+  // products a joint made them memory-bound.
   struct Joint {
-    int contact;
-    Mat6 member, hub_rows, reduced; // D_j^-1, U_j, D_j^-1 U_j
+    int contact, member;
+    Vec6 member_inverse; // the diagonal of D_j^-1
   };
   struct Block {
     int hub;
@@ -49,7 +50,6 @@ class JointBlocks {
     Mat6 hub_response; // (I + W sum_j U_j^T D_j^-1 U_j)^-1 W: the hub's dv from sum_j U_j^T y_j
   };
   bool factor_block(Block &block, const std::vector<int> &joints) const;
-  int member_of(const Joint &joint) const;
 
   const ContactSystem &sys_;
   const std::vector<int> &owners_;
