@@ -16,11 +16,13 @@ processes:
   damping): its kinetic, rotational and potential energy and the contacts' dissipation
   (f_ID[18]) add up to its starting energy within 2e-3 (symplectic Euler's own drift in free
   fall is 7e-4 of it), serially and on two processes.
-- the heap of examples/clumps (LAMMPS's V-shaped clumps of five spheres, 196 of them, dropped
-  onto a floor), against native fix rigid/small with the same pair style and walls: no atom
-  lost, the heap's height within 10% and its spread within 15% (one seed: over five seeds the
-  twins' spreads are 9.06 +- 0.38 and 9.35 +- 0.37, two standard deviations of their
-  difference 12%; this seed's is +13%; the wider heap's table is in examples/README.md).
+- the heap of examples/clumps as it ships (LAMMPS's V-shaped clumps of five spheres, 588 of
+  them, dropped onto a floor), against native fix rigid/small with the same pair style and
+  walls: no atom lost, the heap's height and spread within 10% and its angle of repose within
+  6 degrees. One seed, whose angle is chaotic: the fix's angle for this deck's second seed was
+  12.3, 16.2, 16.7 and 17.0 degrees under round-off changes of the solve, and over five seeds
+  the twins' differences have a standard deviation of 2.8 degrees; the means over seeds are in
+  examples/README.md.
 - a restart in the middle of the tumbling: the clump is set up again from the positions the
   file holds, its angular momentum kept to 1e-9 and its energy within 1e-3 of the
   uninterrupted run's.
@@ -33,6 +35,7 @@ import os
 import fibre_e2e as e2e
 
 THETA = 30.0
+YWIDTH, CLUMPS = 24, 588  # the heap: examples/clumps as it ships
 DT = 0.01
 T1_STEP, T2_STEP = 200, 1000
 
@@ -249,27 +252,53 @@ def check_heap(args, ck):
     figures = {}
     for mode, dt, steps in (("native", 0.001, 40000), ("fibre", 0.025, 1600)):
         run = e2e.run_lmp(args, open(deck).read(), "clump_heap_" + mode, variables={
-            "mode": mode, "dt": dt, "steps": steps, "ywidth": 8, "seed": 4767548})
+            "mode": mode, "dt": dt, "steps": steps, "ywidth": YWIDTH, "seed": 4767548})
         if not ck.ran(run, "the clump heap, %s: run completes" % mode):
             return
-        ck.check(run.last("Atoms") == 980, "%s: no atom lost" % mode, "%d" % run.last("Atoms"))
-        x, top = [], []
+        ck.check(run.last("Atoms") == 5 * CLUMPS, "%s: no atom lost" % mode,
+                 "%d" % run.last("Atoms"))
         with open(os.path.join(args.workdir, "dump.clumps.%s.4767548" % mode)) as f:
             lines = f.read().splitlines()
         start = next(k for k, line in enumerate(lines) if line.startswith("ITEM: ATOMS")) + 1
-        for line in lines[start:]:
-            v = [float(t) for t in line.split()]
-            x.append(v[2])
-            top.append(v[4] + v[5])
-        mean = sum(x) / len(x)
-        top.sort()
-        spread = math.sqrt(sum((a - mean) ** 2 for a in x) / len(x))
-        figures[mode] = (top[int(0.99 * len(top))], spread)
+        figures[mode] = heap_figures([[float(t) for t in line.split()] for line in lines[start:]],
+                                     YWIDTH)
     if len(figures) == 2:
         ck.agree(figures["fibre"][0], figures["native"][0], 0.10,
                  "the heap's height within 10% of native's", "%.3f")
-        ck.agree(figures["fibre"][1], figures["native"][1], 0.15,
-                 "the heap's spread within 15% of native's", "%.3f")
+        ck.agree(figures["fibre"][1], figures["native"][1], 0.10,
+                 "the heap's spread within 10% of native's", "%.3f")
+        diff = figures["fibre"][2] - figures["native"][2]
+        ck.check(abs(diff) < 6.0, "the heap's angle of repose within 6 degrees of native's",
+                 "%.1f against %.1f" % (figures["fibre"][2], figures["native"][2]))
+
+
+def heap_figures(atoms, ywidth):
+    """Height (99th percentile of the tops), spread (standard deviation of x) and angle of
+    repose (the flanks' fitted slope) of a heap from dump rows id mol x y z radius, as
+    examples/clumps/clumps.py measures them: per unit bin of x the mean over 4-wide bins of y
+    of the highest top, fitted against the distance from the centre where it lies between 15%
+    and 85% of the height."""
+    x = [a[2] for a in atoms]
+    top = sorted(a[4] + a[5] for a in atoms)
+    at = 0.99 * (len(top) - 1)  # numpy's percentile: linear between the two nearest
+    height = top[int(at)] + (at - int(at)) * (top[min(int(at) + 1, len(top) - 1)] - top[int(at)])
+    xc = sum(x) / len(x)
+    spread = math.sqrt(sum((v - xc) ** 2 for v in x) / len(x))
+    highest = {}
+    for a in atoms:
+        if 0.0 <= a[3] < ywidth:  # an atom just outside the periodic box is in no bin
+            key = (int(math.floor(a[2])), int(math.floor(a[3] / 4.0)))
+            highest[key] = max(highest.get(key, -math.inf), a[4] + a[5])
+    d, h = [], []
+    for lo in range(60):
+        tops = [t for (i, _), t in highest.items() if i == lo]
+        if tops and 0.15 * height < sum(tops) / len(tops) < 0.85 * height:
+            d.append(abs(lo + 0.5 - xc))
+            h.append(sum(tops) / len(tops))
+    dm, hm = sum(d) / len(d), sum(h) / len(h)
+    slope = (sum((a - dm) * (b - hm) for a, b in zip(d, h)) /
+             sum((a - dm) ** 2 for a in d))
+    return height, spread, math.degrees(math.atan(-slope))
 
 
 def check_errors(args, ck):
