@@ -94,7 +94,8 @@ bool JointBlocks::factor_block(Block &block, const std::vector<int> &joints) con
 
 // Per block: the members' answers y_j = D_j^-1 r_j, the hub's velocity change dw from
 // sum_j U_j^T y_j, then each joint's impulse change y_j - D_j^-1 U_j dw.
-void JointBlocks::solve(const Vector &b, Vector &lambda, Vector &dv, double norms[2]) const
+void JointBlocks::solve(const Vector &b, Vector &lambda, Vector &dv, double norms[2],
+                        double &joints) const
 {
   const double *sigma = sys_.sigma().data();
   double *w = dv.data();
@@ -126,6 +127,7 @@ void JointBlocks::solve(const Vector &b, Vector &lambda, Vector &dv, double norm
         lambda[at + i] += delta[i];
         norms[0] += delta[i] * delta[i];
         norms[1] += lambda[at + i] * lambda[at + i];
+        joints += lambda[at + i] * lambda[at + i];
       }
       contact_impulse<kRows>(q, q + 9, q + 12, delta, ya, nullptr);
       double *w_member = w + kRows * std::size_t(joint.member);

@@ -35,6 +35,11 @@ void PgsResult::record(double change, bool full)
 
 double PgsResult::error_estimate() const
 {
+  return contact_scale * impulse_estimate();
+}
+
+double PgsResult::impulse_estimate() const
+{
   if (last_change == 0) return 0;
   // Anderson: the error is (I - J)^-1 f, at most |f| over the smallest singular value of
   // I - J; the history's estimate of it is an upper bound (a column, not the subspace's
@@ -431,7 +436,7 @@ void PgsRun::sweep_and_sum(const int *visit, int n, GroupedSweep *group, const J
   else
     fibre::sweep<3>(sys_, cones_, b_, inv_mass_, inv_scale_, ex_.local_owners(), visit, n, lambda_,
                     dv_, norms, changes);
-  if (joints) joints->solve(b_, lambda_, dv_, norms);
+  if (joints) joints->solve(b_, lambda_, dv_, norms, norms[2]);
   if (!halo_) return;
   const Vector &split = shares_.split;
   if (!halo_bodies_) {
@@ -457,7 +462,7 @@ bool PgsRun::sweep(int s)
   if (halo_) keep_start();
   if (control_.nonlinear_cg || s % kCheckpointSweeps == 0) lambda_start_ = lambda_;
   if (blocks_) blocks_->correct(b_, lambda_, dv_);
-  double norms[2] = {0, 0}; // ||change||^2, ||lambda||^2
+  double norms[3] = {0, 0, 0}; // ||change||^2, ||lambda||^2, the joints' ||lambda||^2
   // focused: the first sweep is full, then every (P + 1)-th counted from min_sweeps (so the
   // rules can stop where plain sweeps would); the P between visit the focus list
   const int focus_period = control_.focus_sweeps + 1;
@@ -489,7 +494,7 @@ bool PgsRun::sweep(int s)
   }
   if (changes) focus_list(contact_changes_, norms[0], focus_contacts_);
   res_.visits += count;
-  ex_.sum(norms, 2);
+  ex_.sum(norms, joints_.empty() ? 2 : 3);
   ++res_.sweeps;
   if (!std::isfinite(norms[0]) || !std::isfinite(norms[1])) {
     lambda_ = lambda_start_;
@@ -499,6 +504,8 @@ bool PgsRun::sweep(int s)
     return true;
   }
   res_.record(norms[1] > 0 ? std::sqrt(norms[0] / norms[1]) : 0.0, full);
+  if (norms[2] > 0 && norms[1] > norms[2])
+    res_.contact_scale = std::sqrt(norms[1] / (norms[1] - norms[2]));
   // lambda is this sweep's result (feasible); a new smallest change is kept now and then
   if (mixing && s % kCheckpointSweeps == 0 && res_.last_change < best_) {
     lambda_best_ = lambda_;

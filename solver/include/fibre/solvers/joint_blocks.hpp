@@ -31,8 +31,9 @@ class JointBlocks {
   // The contacts of `list` (or all) that no block holds, in their order.
   const std::vector<int> &others() const { return others_; }
   // Each block's impulses moved to solve its rows exactly against the current dv, and dv
-  // follows; ||change||^2 and ||lambda||^2 of the blocks' rows added to norms, as a sweep does.
-  void solve(const Vector &b, Vector &lambda, Vector &dv, double norms[2]) const;
+  // follows; ||change||^2 and ||lambda||^2 of the blocks' rows added to norms, as a sweep does,
+  // and ||lambda||^2 to joints.
+  void solve(const Vector &b, Vector &lambda, Vector &dv, double norms[2], double &joints) const;
 
  private:
   // Joint j's member part D_j = G_a M_a^-1 G_a^T + Sigma_j is diagonal (the joint's point is
