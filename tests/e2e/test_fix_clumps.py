@@ -15,7 +15,8 @@ processes:
 - a clump of three spheres dropped tumbling onto a floor (pair granular, Hertz with Tsuji
   damping): its kinetic, rotational and potential energy and the contacts' dissipation
   (f_ID[18]) add up to its starting energy within 2e-3 (symplectic Euler's own drift in free
-  fall is 7e-4 of it), serially and on two processes.
+  fall is 7e-4 of it), serially and on two processes, and on two processes with the clump on
+  one and a lone sphere dropped on the other (a process whose contacts hold no joint).
 - the heap of examples/clumps as it ships (LAMMPS's V-shaped clumps of five spheres, 588 of
   them, dropped onto a floor), against native fix rigid/small with the same pair style and
   walls: no atom lost, the heap's height and spread within 10% and its angle of repose within
@@ -211,11 +212,18 @@ def check_restart(args, ck, uninterrupted):
              "after the restart: the energy of the uninterrupted run", "%.8g")
 
 
-def drop_deck(processors=None):
-    lines = clump_opening("-10 10 -10 10 -1 20", [(0, 0, 3), (0.8, 0.3, 3.5), (-0.7, 0.5, 3.4)],
+def drop_deck(processors=None, apart=False):
+    """apart: the clump on one process (x > 0) and a lone sphere, a clump of one, dropped on
+    the other's side: a process whose contacts hold no joint beside one whose do."""
+    spheres = [(0, 0, 3), (0.8, 0.3, 3.5), (-0.7, 0.5, 3.4)]
+    if apart:
+        spheres = [(x + 5.0, y, z) for x, y, z in spheres] + [(-5.0, 0.0, 2.0)]
+    lines = clump_opening("-10 10 -10 10 -1 20", spheres,
                           3.0, processors=processors, law="granular",
                           coeff="hertz/material 1e5 0.3 0.3 tangential mindlin NULL 1.0 0.5 "
                           "damping tsuji", dt=0.001)
+    if apart:
+        lines.append("set atom 4 mol 2")
     return "\n".join(lines + [
         "velocity all set 0.5 0 0",
         "fix g all gravity 9.81 vector 0 0 -1",
@@ -232,10 +240,11 @@ def drop_deck(processors=None):
 
 
 def check_drop(args, ck):
-    for np in (1, 2):
-        run = e2e.run_lmp(args, drop_deck("2 1 1" if np > 1 else None), "clump_drop_np%d" % np,
-                          np=np)
-        if not ck.ran(run, "a clump dropped onto a floor, np %d: run completes" % np):
+    for np, apart in ((1, False), (2, False), (2, True)):
+        name = "a clump dropped onto a floor, np %d%s" % (np, ", a lone sphere apart" * apart)
+        run = e2e.run_lmp(args, drop_deck("2 1 1" if np > 1 else None, apart),
+                          "clump_drop_np%d%s" % (np, "_apart" * apart), np=np)
+        if not ck.ran(run, name + ": run completes"):
             continue
         rows = run.thermo[-1]
         e0 = rows[0]["v_total"]

@@ -494,7 +494,7 @@ bool PgsRun::sweep(int s)
   }
   if (changes) focus_list(contact_changes_, norms[0], focus_contacts_);
   res_.visits += count;
-  ex_.sum(norms, joints_.empty() ? 2 : 3);
+  ex_.sum(norms, 3); // every process alike, with joints or without
   ++res_.sweeps;
   if (!std::isfinite(norms[0]) || !std::isfinite(norms[1])) {
     lambda_ = lambda_start_;
