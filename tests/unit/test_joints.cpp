@@ -142,7 +142,7 @@ TEST(Joints, OneSweepSolvesAClumpsJointsExactly)
       pgs(sys, serial_exchange(), Cones(sys), b, row_scales(sys), lambda, PgsControl{1, 0.0, 1000});
   EXPECT_EQ(r.sweeps, 1);
   EXPECT_LT((lambda - exact).norm(), 1e-10 * exact.norm()) << (lambda - exact).norm();
-  // without the block (its joints swept one at a time, as without six rows) one sweep is far off
+  // each joint solved alone against b (the first joint of a one-at-a-time sweep) is far off
   Vector one_at_a_time = Vector::Zero(sys.contact_dofs());
   for (int c = 0; c < sys.num_contacts(); ++c) {
     const Eigen::MatrixXd Acc = A.block(6 * c, 6 * c, 6, 6);

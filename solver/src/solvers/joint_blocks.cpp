@@ -5,6 +5,7 @@
 #include <unordered_map>
 
 #include "fibre/algebra/contact_rows.hpp"
+#include "fibre/core/exchange.hpp"
 
 namespace fibre {
 
@@ -16,11 +17,6 @@ constexpr int kRows = 6; // a joint's rows; blocks only where every contact has 
 const double *rows_of(const ContactSystem &sys, int c)
 {
   return sys.kinematics(0).frame.data() + 15 * std::size_t(c);
-}
-
-int owner_of(const std::vector<int> &owners, int body)
-{
-  return owners.empty() || body < 0 ? body : owners[body];
 }
 
 } // namespace

@@ -114,12 +114,6 @@ template <class V> auto body_entries(V &v, int body)
   return v.template segment<kBodyDofs>(kBodyDofs * Eigen::Index(body));
 }
 
-// The body that holds a local body's velocity: itself, or an image's body (Exchange::local_owners).
-int owner_of(const std::vector<int> &owners, int body)
-{
-  return owners.empty() ? body : owners[body];
-}
-
 // Per local body, whether this process's contacts move it (an image's velocity is its body's).
 std::vector<char> touched_bodies(const ContactSystem &sys, const Exchange &ex)
 {

@@ -4,22 +4,14 @@
 #include <cstdint>
 #include <stdexcept>
 
+#include "fibre/core/exchange.hpp"
+
 #if defined(__x86_64__) && defined(__GNUC__)
 #define FIBRE_GROUPED_SWEEPS 1
 #include <immintrin.h>
 #endif
 
 namespace fibre {
-
-namespace {
-
-// The body that holds a body's velocity: itself, or a periodic image's body; -1 (a wall) stays.
-int owner_of(const std::vector<int> &owners, int body)
-{
-  return owners.empty() || body < 0 ? body : owners[body];
-}
-
-} // namespace
 
 ContactGroups group_contacts(const ContactSystem &sys, const std::vector<int> &owners,
                              const std::vector<int> *list)

@@ -13,6 +13,13 @@
 
 namespace fibre {
 
+// The body that holds a local body's velocity under Exchange::local_owners: itself, or a
+// periodic image's body; -1 (a wall) stays.
+inline int owner_of(const std::vector<int> &owners, int body)
+{
+  return owners.empty() || body < 0 ? body : owners[body];
+}
+
 class Exchange {
  public:
   virtual ~Exchange() = default;
