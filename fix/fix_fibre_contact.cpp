@@ -270,6 +270,8 @@ void FixFibreContact::init()
   const std::vector<int> types =
       fibre_lmp::wall_material_types(lmp, walls, model.per_type() ? &model.materials : nullptr);
   for (std::size_t k = 0; k < walls.size(); ++k) walls[k].type = types[k];
+  // rows auto: the rotational rows where a law rolls or twists, and for the clumps' joints
+  if (model.rows_auto) model.rows = clumps_ ? 6 : model.rows_needed();
   detection_->init_walls(walls);
   detection_->set_materials(model.per_type() ? &model.materials : nullptr);
   if (comm->me == 0) logmesg(lmp, "fix fibre_contact: " + fibre::describe(settings_) + "\n");

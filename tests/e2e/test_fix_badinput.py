@@ -77,7 +77,7 @@ CASES = [
     ("mu_roll_text", "mu_roll rough", "expected 'mu_roll <non-negative number>', got 'rough'",
      {}),
     ("mu_twist_missing", "mu_twist", "expected 'mu_twist <non-negative number>'", {}),
-    ("rows_invalid", "rows 4", "expected 'rows 3|6', got '4'", {}),
+    ("rows_invalid", "rows 4", "expected 'rows 3|6|auto', got '4'", {}),
     ("active_set_zero", "active_set 0", "expected 'active_set <positive integer>', got '0'",
      {}),
     ("wall_kind", "wall cylinder 1 2", "'wall xplane|yplane|zplane <lo|NULL> <hi|NULL>', "

@@ -176,6 +176,36 @@ TEST(Material, AddedTypeIsEveryTypesPartner)
   for (int i = 1; i <= 3; ++i) EXPECT_EQ(table.at(i, 3).mu, 0.7) << i;
 }
 
+// rows auto: the rotational rows where a contact can roll or twist against a resistance.
+TEST(Material, RowsNeededFollowTheRollingAndTwistingLaws)
+{
+  ContactModel model;
+  EXPECT_EQ(model.rows_needed(), 3); // the fix's own coefficients: mu_roll 0, mu_twist 0
+  model.friction.mu_roll = 0.1;
+  EXPECT_EQ(model.rows_needed(), 6);
+  model.friction.mu_roll = 0.0;
+  model.materials = MaterialTable(2);
+  for (int i = 1; i <= 2; ++i)
+    for (int j = i; j <= 2; ++j) {
+      model.materials.at(i, j).set = true;
+      model.materials.at(i, j).mu = 0.5;
+    }
+  EXPECT_EQ(model.rows_needed(), 3);
+  model.materials.at(1, 2).mu_roll = 0.1; // one pair rolls
+  EXPECT_EQ(model.rows_needed(), 6);
+  model.typed.mu_roll = true; // a typed mu_roll 0 overrides every pair's
+  EXPECT_EQ(model.rows_needed(), 3);
+  model.materials.at(2, 2).twist = TwistLaw::sds;
+  model.materials.at(2, 2).twist_coeff = 0.0;
+  EXPECT_EQ(model.rows_needed(), 3);                   // sds without a coefficient resists nothing
+  model.materials.at(2, 2).twist = TwistLaw::marshall; // its limit follows mu
+  EXPECT_EQ(model.rows_needed(), 6);
+  model.coefficients = CoefficientSource::fix; // the fix's mu_twist 0 for every contact
+  EXPECT_EQ(model.rows_needed(), 3);
+  model.friction.mu_twist = 0.02;
+  EXPECT_EQ(model.rows_needed(), 6);
+}
+
 TEST(Material, MixingIsGeometric)
 {
   MaterialTable t(3);

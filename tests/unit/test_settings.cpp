@@ -66,7 +66,7 @@ TEST(Settings, NoKeywordsKeepTheDefaults)
       describe(s),
       "form body, solver pgs, precond tree, weight z, tol 0.0001, linear_tol 0.0001, pass_tol "
       "0.001, maxiter 200, active_set 1, sweeps 2000, sweep_tol 0.001, rescue_sweeps 500, "
-      "min_sweeps 10, focus_sweeps 0, anderson 3, anderson_period 2, rows 6, damping 2, "
+      "min_sweeps 10, focus_sweeps 0, anderson 3, anderson_period 2, rows 6 (auto), damping 2, "
       "compliance auto "
       "(0.01 dt^2 / m_min), recovery_speed auto (0.01 r_min / dt), restitution 0, "
       "bounce_speed auto (2 dt |f| / m max, or 0.01 r_min / dt without forces), coefficients "
@@ -216,7 +216,7 @@ TEST(Settings, BadInputNamesTheKeywordAndItsForm)
   EXPECT_EQ(error_of("maxiter 2.5"), "expected 'maxiter <positive integer>', got '2.5'");
   EXPECT_EQ(error_of("sweeps -1"), "expected 'sweeps <non-negative integer>', got '-1'");
   EXPECT_EQ(error_of("mu -0.1"), "expected 'mu <non-negative number>', got '-0.1'");
-  EXPECT_EQ(error_of("rows 4"), "expected 'rows 3|6', got '4'");
+  EXPECT_EQ(error_of("rows 4"), "expected 'rows 3|6|auto', got '4'");
   EXPECT_EQ(error_of("clumps rigid"), "expected 'clumps molecule|none', got 'rigid'");
   EXPECT_EQ(error_of("clumps"), "expected 'clumps molecule|none'");
   EXPECT_TRUE(parse_settings(words("clumps molecule")).clumps);
@@ -270,6 +270,8 @@ TEST(Settings, BadInputNamesTheKeywordAndItsForm)
   EXPECT_EQ(error_of("solver nncg anderson 3"),
             "anderson accelerates plain sweeps: not with solver nncg, apgd or fbgs, sweep_cg yes, "
             "sweep_blocks yes, or focus_sweeps");
+  EXPECT_TRUE(parse_settings(words("rows 3 rows auto mu_roll 0.1")).model.rows_auto);
+  EXPECT_FALSE(parse_settings(words("rows 6")).model.rows_auto);
   EXPECT_EQ(error_of("rows 3 mu_roll 0.1"),
             "mu_roll and mu_twist need 'rows 6' (rows 3 has no rotational rows)");
   EXPECT_EQ(error_of("substeps 0"), "expected 'substeps auto|<integer 1 to 1000>', got '0'");

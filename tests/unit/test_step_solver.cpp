@@ -786,6 +786,30 @@ TEST(ContactSolver, ConservesMomentum)
   }
 }
 
+// Without rolling or twisting resistance the rotational rows carry nothing: three rows per
+// contact (rows auto) give the six rows' step, converged, to round-off.
+TEST(ContactSolver, ThreeRowsSolveTheStepOfSixWithoutRollingOrTwisting)
+{
+  SceneParams p;
+  p.seed = 5;
+  const ContactSystem pile = pile_scene(80, p);
+  StepOptions o; // the default sweeps, converged
+  o.accuracy = 1e-12;
+  o.sweeps = 20000;
+  Vector dv[2];
+  for (int rows : {6, 3}) {
+    ContactSystem sys(pile.bodies(), pile.contacts(), rows, pile.params());
+    sys.set_friction(FrictionParams{0.5, 0.0, 0.0});
+    const StepResult res = solve(sys, o);
+    ASSERT_TRUE(res.converged) << rows;
+    for (int c = 0; rows == 6 && c < sys.num_contacts(); ++c)
+      EXPECT_EQ(res.lambda.segment<3>(6 * c + 3).norm(), 0.0) << c;
+    dv[rows == 3] = res.dv;
+  }
+  ASSERT_GT(dv[0].norm(), 0.0);
+  EXPECT_LT((dv[1] - dv[0]).norm(), 1e-9 * dv[0].norm());
+}
+
 // Final impulses are feasible, and once the set has settled they satisfy the contact
 // conditions: active rows solved, released contacts do not press, capped cones slip.
 TEST(ContactSolver, FeasibleAndConsistentOnPile)

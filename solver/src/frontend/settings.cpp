@@ -322,10 +322,14 @@ std::vector<Keyword> contact_keywords()
          st.s.model.coefficients = in.name<CoefficientSource>(i + 1, in.at(i));
          return 2;
        }},
-      {{"rows", U, "'rows 3|6'", "3: normal and tangential rows; 6: with rolling and twisting"},
+      {{"rows", U, "'rows 3|6|auto'",
+        "3: normal and tangential rows; 6: with rolling and twisting; auto: 6 where a law rolls "
+        "or twists"},
        [](const Reader &in, std::size_t i, const std::string &e, ParseState &st) -> std::size_t {
          long v = 0;
          if (!in.has(i + 1)) Reader::illegal(e);
+         st.s.model.rows_auto = in.at(i + 1) == "auto";
+         if (st.s.model.rows_auto) return 2;
          if (!to_long(in.at(i + 1), v) || (v != 3 && v != 6)) Reader::illegal(e, &in.at(i + 1));
          st.s.model.rows = static_cast<int>(v);
          return 2;
@@ -623,7 +627,7 @@ void finish_settings(const ParseState &st, Settings &s)
     throw SettingsError("anderson accelerates plain sweeps: not with solver nncg, apgd or fbgs, "
                         "sweep_cg yes, sweep_blocks yes, or focus_sweeps");
   const FrictionParams &f = s.model.friction;
-  if (s.model.rows == 3 && (f.mu_roll > 0.0 || f.mu_twist > 0.0))
+  if (!s.model.rows_auto && s.model.rows == 3 && (f.mu_roll > 0.0 || f.mu_twist > 0.0))
     throw SettingsError("mu_roll and mu_twist need 'rows 6' (rows 3 has no rotational rows)");
 }
 
@@ -666,7 +670,8 @@ int steps_per_solve(double t_c, double dt)
 std::string describe(const Settings &s)
 {
   const ComplianceParams &c = s.model.compliance;
-  std::string out = describe(s.step) + ", rows " + std::to_string(s.model.rows) + ", damping " +
+  std::string out = describe(s.step) + ", rows " + std::to_string(s.model.rows) +
+                    (s.model.rows_auto ? " (auto)" : "") + ", damping " +
                     format_g(s.model.damping) + ", compliance ";
   if (c.material)
     out += std::string("material (pair style, else ") + format_g(c.factor) + " dt^2 / m_min" +

@@ -348,6 +348,22 @@ bool ContactModel::may_bounce() const
   return false;
 }
 
+int ContactModel::rows_needed() const
+{
+  const bool pairs = per_type();
+  bool rotational = (!pairs || typed.mu_roll) && friction.mu_roll > 0;
+  rotational = rotational || ((!pairs || typed.mu_twist) && friction.mu_twist > 0);
+  for (int i = 1; pairs && i <= materials.ntypes(); ++i)
+    for (int j = i; j <= materials.ntypes(); ++j) {
+      const PairCoefficients &p = materials.at(i, j);
+      const bool twists = p.twist == TwistLaw::marshall ? p.mu > 0
+                          : p.twist == TwistLaw::sds    ? p.twist_coeff > 0
+                                                        : false;
+      rotational = rotational || (!typed.mu_roll && p.mu_roll > 0) || (!typed.mu_twist && twists);
+    }
+  return rotational ? 6 : 3;
+}
+
 double external_speed_per_step(const std::vector<Body> &bodies, int num_owned, double h)
 {
   double v = 0.0;

@@ -47,7 +47,10 @@ struct TypedCoefficients {
 
 // The model of one simulation: rows per contact, SPOOK damping, compliance and friction.
 struct ContactModel {
-  int rows = 6;         // 3: translational rows only; 6: with twisting and rolling
+  int rows = 6; // 3: translational rows only; 6: with twisting and rolling
+  // rows auto (the default): the front end sets rows from rows_needed() once the pair style's
+  // coefficients are read; false once 'rows 3|6' is typed.
+  bool rows_auto = true;
   double damping = 2.0; // SPOOK d = tau / h, in steps
   ComplianceParams compliance{};
   FrictionParams friction{}; // of every contact (one material)
@@ -84,6 +87,10 @@ struct ContactModel {
   bool per_type() const { return coefficients == CoefficientSource::pair && !materials.empty(); }
   // Whether any contact can have a restitution above 0 (the keyword or a type pair's).
   bool may_bounce() const;
+  // The rows a contact needs: 6 where some contact can carry a rolling or twisting impulse (the
+  // model's or a type pair's mu_roll or twisting law), else 3. Without one the rotational rows
+  // carry zeros, at a fifth of a step's cost.
+  int rows_needed() const;
 };
 
 // The automatic bounce speed's scale: max over bodies of h |f| / m (local; a front end takes
