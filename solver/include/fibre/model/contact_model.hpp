@@ -88,8 +88,8 @@ struct ContactModel {
   // Whether any contact can have a restitution above 0 (the keyword or a type pair's).
   bool may_bounce() const;
   // The rows a contact needs: 6 where some contact can carry a rolling or twisting impulse (the
-  // model's or a type pair's mu_roll or twisting law), else 3. Without one the rotational rows
-  // carry zeros, at a fifth of a step's cost.
+  // model's or a type pair's mu_roll or twisting law), else 3: without one the rotational rows
+  // would carry only zeros.
   int rows_needed() const;
 };
 
