@@ -180,14 +180,21 @@ void FixFibreContact::check_finite(const char *what, double **array, int nvalues
   // x * 0 is 0 for finite x and NaN otherwise: one branch-free pass (it ran nine times a
   // step, 5% of a flow's time), and the atom named only when the sum is not 0
   // (LAMMPS's per-atom arrays are contiguous: memory->create)
+  // Four sums: one waited on each addition's latency (6% of a stream of free grains' step).
   const int n = atom->nlocal;
   const double *values = n > 0 ? array[0] : nullptr;
+  const auto zero = [&](int i) {
+    const double *v = values + 3 * std::size_t(i);
+    return (mask[i] & groupbit) ? v[0] * 0.0 + v[1] * 0.0 + v[2] * 0.0 : 0.0;
+  };
   double sum = 0.0;
   if (nvalues == 3) {
-    for (int i = 0; i < n; ++i) {
-      const double zero = values[3 * i] * 0.0 + values[3 * i + 1] * 0.0 + values[3 * i + 2] * 0.0;
-      sum += (mask[i] & groupbit) ? zero : 0.0;
-    }
+    double sums[4] = {0.0, 0.0, 0.0, 0.0};
+    int i = 0;
+    for (; i + 4 <= n; i += 4)
+      for (int k = 0; k < 4; ++k) sums[k] += zero(i + k);
+    for (; i < n; ++i) sums[0] += zero(i);
+    sum = (sums[0] + sums[1]) + (sums[2] + sums[3]);
   } else {
     sum = 1.0; // the naming loop below
   }
