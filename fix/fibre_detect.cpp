@@ -127,11 +127,13 @@ fibre::FoundContacts LammpsDetection::contacts(const std::vector<fibre::Body> &b
                                                bool recovering)
 {
   std::vector<fibre::DetectedContact> found;
+  std::vector<fibre::DetectedPair> pairs;
   found.reserve(last_found_ + last_found_ / 8 + 16); // about the last step's, without regrowth
+  pairs.reserve(last_pairs_ + last_pairs_ / 8 + 16);
   kick_.clear();
   speed_.resize(bodies.size());
   for (std::size_t k = 0; k < bodies.size(); ++k) speed_[k] = fibre::free_speed(bodies[k], h);
-  pair_contacts(bodies, h, damping, found);
+  pair_contacts(bodies, h, damping, found, pairs);
   wall_contacts(bodies, h, damping, found);
   // A rigid row's penetration is opened by a displacement of up to `recovery` a step
   // (fibre/step/recovery.hpp), which moves the bodies around it too: every body may move that
@@ -141,21 +143,24 @@ fibre::FoundContacts LammpsDetection::contacts(const std::vector<fibre::Body> &b
   if (recovery > 0 && !recovering) {
     for (const fibre::DetectedContact &fc : found)
       if (-fc.contact.gap > fibre::kPenetrationStart * recovery) deep = 1.0;
+    for (const fibre::DetectedPair &fp : pairs)
+      if (-fp.gap > fibre::kPenetrationStart * recovery) deep = 1.0;
     exchange_.max(&deep, 1);
   }
   if (impacts || deep > 0) {
     const int nbody = static_cast<int>(bodies.size());
     fibre::Vector kick = fibre::Vector::Zero(6 * Eigen::Index(nbody));
-    if (impacts) impact_kicks(bodies, h, found, kick);
+    if (impacts) impact_kicks(bodies, h, found, pairs, kick);
     kick_.resize(nbody);
     for (int k = 0; k < nbody; ++k) kick_[k] = kick[6 * k] + (deep > 0 ? recovery / h : 0.0);
     // the second pass adds what the kicks reach; the first pass's contacts stand
-    pair_contacts(bodies, h, damping, found);
+    pair_contacts(bodies, h, damping, found, pairs);
     wall_contacts(bodies, h, damping, found);
   }
   if (clumps_) clumps_->joints(bodies, atom_body_, found);
   last_found_ = found.size();
-  return fibre::sort_contacts(std::move(found));
+  last_pairs_ = pairs.size();
+  return fibre::sort_contacts(std::move(found), std::move(pairs), &bodies);
 }
 
 // An impact changes both bodies' velocities within the step by up to twice the approach speed:
@@ -164,17 +169,21 @@ fibre::FoundContacts LammpsDetection::contacts(const std::vector<fibre::Body> &b
 // the first of each set.
 void LammpsDetection::impact_kicks(const std::vector<fibre::Body> &bodies, double h,
                                    const std::vector<fibre::DetectedContact> &found,
+                                   const std::vector<fibre::DetectedPair> &pairs,
                                    fibre::Vector &kick) const
 {
+  const auto add = [&](int a, int b, double approach) {
+    if (!(approach > 0.0)) return;
+    kick[6 * a] = std::max(kick[6 * a], 2.0 * approach);
+    if (b >= 0) kick[6 * b] = std::max(kick[6 * b], 2.0 * approach);
+  };
   for (const fibre::DetectedContact &fc : found) {
     const fibre::Contact &c = fc.contact;
     const fibre::Body *b = c.is_wall() ? nullptr : &bodies[c.b];
-    const double approach =
-        fibre::free_approach(bodies[c.a], b, c.normal, h) + c.normal.dot(c.wall_v);
-    if (!(approach > 0.0)) continue;
-    kick[6 * c.a] = std::max(kick[6 * c.a], 2.0 * approach);
-    if (!c.is_wall()) kick[6 * c.b] = std::max(kick[6 * c.b], 2.0 * approach);
+    add(c.a, c.b, fibre::free_approach(bodies[c.a], b, c.normal, h) + c.normal.dot(c.wall_v));
   }
+  for (const fibre::DetectedPair &fp : pairs)
+    add(fp.a, fp.b, fibre::free_approach(bodies[fp.a], &bodies[fp.b], fp.normal, h));
   exchange_.reverse_sum(kick);
   exchange_.forward(kick);
 }
@@ -196,7 +205,8 @@ bool LammpsDetection::accept(const fibre::Body &a, const fibre::Body *b, const f
 // newton_pair on a pair with a ghost is listed on one process only; with newton_pair off it is
 // listed on both and the process owning the atom with the smaller tag keeps it.
 void LammpsDetection::pair_contacts(const std::vector<fibre::Body> &bodies, double h,
-                                    double damping, std::vector<fibre::DetectedContact> &found)
+                                    double damping, std::vector<fibre::DetectedContact> &found,
+                                    std::vector<fibre::DetectedPair> &pairs)
 {
   std::string style;
   NeighList *list = fibre_lmp::granular_pair(lmp, style)->list;
@@ -237,7 +247,7 @@ void LammpsDetection::pair_contacts(const std::vector<fibre::Body> &bodies, doub
       // the atom with the smaller tag stores the warm start if it is owned here
       const int low = tag[i] < tag[j] ? i : j, high = low == i ? j : i;
       const int store = low < nlocal ? low : high;
-      const auto keep = [&](fibre::DetectedContact &fc) {
+      const auto keep = [&](fibre::ContactTag &fc) {
         fc.store = store;
         fc.key = tag[store] == fc.tag_a ? fc.partner : static_cast<double>(fc.tag_a);
       };
@@ -254,12 +264,14 @@ void LammpsDetection::pair_contacts(const std::vector<fibre::Body> &bodies, doub
         fibre::sphere_sphere_gap(bodies[a], bodies[b], normal, gap);
         if (!accept(bodies[a], &bodies[b], normal, gap, h, damping, kick(a) + kick(b), 0.0, hold))
           continue;
-        // built only here: most listed pairs are no contact, and a Contact is hundreds of bytes
-        fibre::DetectedContact &fc = found.emplace_back();
-        fc.contact = fibre::sphere_sphere_contact(bodies, a, b, normal, gap);
-        fc.tag_a = tag[low];
-        fc.partner = static_cast<double>(tag[high]);
-        keep(fc);
+        fibre::DetectedPair &fp = pairs.emplace_back();
+        fp.a = a;
+        fp.b = b;
+        fp.normal = normal;
+        fp.gap = gap;
+        fp.tag_a = tag[low];
+        fp.partner = static_cast<double>(tag[high]);
+        keep(fp);
         taken_[pair] = 1;
       } else {
         // one atom is outside the group: a fixed spherical obstacle

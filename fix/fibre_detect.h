@@ -52,10 +52,13 @@ class LammpsDetection : protected LAMMPS_NS::Pointers {
                                 bool recovering = false);
 
  private:
+  // pairs of group atoms into `pairs`, a group atom against one outside (an obstacle) into found
   void pair_contacts(const std::vector<fibre::Body> &bodies, double h, double damping,
-                     std::vector<fibre::DetectedContact> &found);
+                     std::vector<fibre::DetectedContact> &found,
+                     std::vector<fibre::DetectedPair> &pairs);
   void impact_kicks(const std::vector<fibre::Body> &bodies, double h,
-                    const std::vector<fibre::DetectedContact> &found, fibre::Vector &kick) const;
+                    const std::vector<fibre::DetectedContact> &found,
+                    const std::vector<fibre::DetectedPair> &pairs, fibre::Vector &kick) const;
   void wall_contacts(const std::vector<fibre::Body> &bodies, double h, double damping,
                      std::vector<fibre::DetectedContact> &found) const;
   // A wall contact of body with the wall's surface velocity at the point and angular velocity.
@@ -95,7 +98,8 @@ class LammpsDetection : protected LAMMPS_NS::Pointers {
   // would only reject again (its accept asks for a contact that the first pass did not take)
   std::vector<unsigned char> taken_;
   std::vector<double> speed_;  // per body: its free speed over this step (fibre::free_speed)
-  std::size_t last_found_ = 0; // contacts found in the last step
+  std::size_t last_found_ = 0; // contacts found in the last step, besides pairs
+  std::size_t last_pairs_ = 0; // pairs found in the last step
   std::unique_ptr<HostWalls> host_walls_;
   std::vector<int> atom_body_; // local atom -> body index, -1 if not a body
   // the atoms at the last call of bodies() (same_atoms): the owned count, and per atom its tag

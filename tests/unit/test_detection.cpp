@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <random>
+#include <stdexcept>
 #include <tuple>
 
 #include "fibre/geometry/detection.hpp"
@@ -206,6 +207,66 @@ TEST(Detection, SortOrdersByTagPartnerAndGap)
       EXPECT_EQ(sorted.contacts[k].gap, expected[k].contact.gap);
     }
   }
+}
+
+// Pairs given as compact records (DetectedPair) sort among the walls' full contacts as the
+// same pairs given as full contacts (sphere_sphere_contact), each built bit for bit alike.
+TEST(Detection, PairRecordsSortAsTheirContacts)
+{
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  std::vector<Body> bodies(40);
+  for (Body &b : bodies) {
+    b.radius = 0.5 + 0.1 * u(rng);
+    b.x = 2.0 * Vec3(u(rng), u(rng), u(rng));
+  }
+  std::vector<DetectedContact> walls, full;
+  std::vector<DetectedPair> pairs;
+  for (int a = 0; a < 40; ++a) {
+    DetectedContact w;
+    w.tag_a = a + 1;
+    w.partner = wall_key(0, a % 2);
+    w.contact = sphere_wall_contact(bodies, a, Vec3::UnitZ(), 0.4 + 0.01 * a);
+    walls.push_back(w);
+    for (int b = a + 1; b < 40; b += 7) {
+      DetectedPair p;
+      p.a = a;
+      p.b = b;
+      sphere_sphere_gap(bodies[a], bodies[b], p.normal, p.gap);
+      p.tag_a = a + 1;
+      p.partner = b + 1;
+      p.key = b + 1;
+      p.store = a;
+      pairs.push_back(p);
+      DetectedContact c;
+      static_cast<ContactTag &>(c) = p;
+      c.contact = sphere_sphere_contact(bodies, a, b, p.normal, p.gap);
+      full.push_back(c);
+    }
+  }
+  full.insert(full.end(), walls.begin(), walls.end());
+  std::shuffle(pairs.begin(), pairs.end(), std::mt19937(3));
+  const FoundContacts expected = sort_contacts(std::move(full));
+  const FoundContacts sorted = sort_contacts(std::move(walls), std::move(pairs), &bodies);
+  ASSERT_EQ(sorted.contacts.size(), expected.contacts.size());
+  ASSERT_GT(sorted.contacts.size(), 100u);
+  for (std::size_t k = 0; k < sorted.contacts.size(); ++k) {
+    const Contact &c = sorted.contacts[k], &e = expected.contacts[k];
+    EXPECT_EQ(sorted.tags[k].tag_a, expected.tags[k].tag_a) << "contact " << k;
+    EXPECT_EQ(sorted.tags[k].partner, expected.tags[k].partner);
+    EXPECT_EQ(sorted.tags[k].key, expected.tags[k].key);
+    EXPECT_EQ(sorted.tags[k].store, expected.tags[k].store);
+    EXPECT_EQ(sorted.tags[k].gap, expected.tags[k].gap);
+    EXPECT_EQ(c.a, e.a);
+    EXPECT_EQ(c.b, e.b);
+    EXPECT_EQ(c.gap, e.gap);
+    EXPECT_EQ(c.normal, e.normal);
+    EXPECT_EQ(c.t1, e.t1);
+    EXPECT_EQ(c.t2, e.t2);
+    EXPECT_EQ(c.point, e.point);
+  }
+  std::vector<DetectedPair> alone(1);
+  EXPECT_THROW(sort_contacts({}, std::move(alone)), std::invalid_argument);
 }
 
 TEST(Detection, WallNames)

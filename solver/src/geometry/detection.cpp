@@ -3,6 +3,7 @@
 #include <cmath>
 
 #include <algorithm>
+#include <stdexcept>
 
 namespace fibre {
 
@@ -85,11 +86,12 @@ int cylinder_hit(const WallSpec &wall, const Body &b, double reach, PlaneHit &hi
   return 1;
 }
 
-FoundContacts sort_contacts(std::vector<DetectedContact> &&found)
+FoundContacts sort_contacts(std::vector<DetectedContact> &&found, std::vector<DetectedPair> &&pairs,
+                            const std::vector<Body> *bodies)
 {
   // Sort compact keys, then move each contact once: a Contact is a few hundred bytes, so
   // swapping them in the sort was 4% of a step, and reading the keys out of them in every
-  // comparison missed the cache.
+  // comparison missed the cache. Keys from n_found on are pairs.
   struct Key {
     long long tag_a;
     double partner, gap;
@@ -100,13 +102,18 @@ FoundContacts sort_contacts(std::vector<DetectedContact> &&found)
     if (p.partner != q.partner) return p.partner < q.partner;
     return p.gap < q.gap;
   };
-  const std::size_t n = found.size();
+  if (!pairs.empty() && !bodies)
+    throw std::invalid_argument("sort_contacts: pairs without their bodies");
+  const std::size_t n_found = found.size(), n = n_found + pairs.size();
   std::vector<Key> keys(n);
-  long long lo = n ? found[0].tag_a : 0, hi = lo;
-  for (std::size_t i = 0; i < n; ++i) {
+  for (std::size_t i = 0; i < n_found; ++i)
     keys[i] = {found[i].tag_a, found[i].partner, found[i].contact.gap, i};
-    lo = std::min(lo, keys[i].tag_a);
-    hi = std::max(hi, keys[i].tag_a);
+  for (std::size_t i = 0; i < pairs.size(); ++i)
+    keys[n_found + i] = {pairs[i].tag_a, pairs[i].partner, pairs[i].gap, n_found + i};
+  long long lo = n ? keys[0].tag_a : 0, hi = lo;
+  for (const Key &k : keys) {
+    lo = std::min(lo, k.tag_a);
+    hi = std::max(hi, k.tag_a);
   }
   // Tags are dense on a process (its atoms and their ghosts): bucket the keys by tag_a, then
   // order each bucket (a sphere's few contacts) by insertion. A sparse range: a full sort.
@@ -130,10 +137,16 @@ FoundContacts sort_contacts(std::vector<DetectedContact> &&found)
   sorted.contacts.reserve(n);
   sorted.tags.reserve(n);
   for (const Key &k : keys) {
-    const DetectedContact &fc = found[k.index];
-    sorted.contacts.push_back(fc.contact);
-    sorted.tags.push_back(fc);
-    sorted.tags.back().gap = fc.contact.gap;
+    if (k.index < n_found) {
+      const DetectedContact &fc = found[k.index];
+      sorted.contacts.push_back(fc.contact);
+      sorted.tags.push_back(fc);
+      sorted.tags.back().gap = fc.contact.gap;
+    } else {
+      const DetectedPair &fp = pairs[k.index - n_found];
+      sorted.contacts.push_back(sphere_sphere_contact(*bodies, fp.a, fp.b, fp.normal, fp.gap));
+      sorted.tags.push_back(fp);
+    }
   }
   return sorted;
 }

@@ -136,6 +136,14 @@ struct DetectedContact : ContactTag {
   Contact contact;
 };
 
+// A pair of spheres found by a front end: its Contact (sphere_sphere_contact of a, b, normal
+// and ContactTag::gap) is built once the step's contacts are sorted, so the search and the sort
+// move a few dozen bytes a pair, not a Contact's hundreds.
+struct DetectedPair : ContactTag {
+  int a = -1, b = -1;
+  Vec3 normal = Vec3::UnitZ();
+};
+
 // A step's contacts: tags[c] is contacts[c]'s. The contacts go into the system; the tags stay
 // for the history and the outputs.
 struct FoundContacts {
@@ -144,7 +152,9 @@ struct FoundContacts {
 };
 
 // The one order of a step's contacts, independent of storage order and process count:
-// by tag_a, then partner, then gap; each contact moved once.
-FoundContacts sort_contacts(std::vector<DetectedContact> &&found);
+// by tag_a, then partner, then gap; each contact moved once, each pair's built in its place.
+FoundContacts sort_contacts(std::vector<DetectedContact> &&found,
+                            std::vector<DetectedPair> &&pairs = {},
+                            const std::vector<Body> *bodies = nullptr);
 
 } // namespace fibre
