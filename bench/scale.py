@@ -11,8 +11,10 @@ For each run: wall seconds per simulated second, the largest resident set of any
 largest process, over its share of them; the
 fix's contacts at the end, walls included; native's pair contacts from compute contact/atom),
 the fix's sweeps and error estimate of the
-last step, and with --check its last check's velocity error against the converged step. The
-speed ratio is native's wall time over the fix's for the same simulated time.
+last step, with --check its last check's velocity error against the converged step, and the
+sweeps' cost per contact-sweep over the run (a process's sweep seconds over its share of the
+contacts times the sweeps, summed over the steps). The speed ratio is native's wall time over
+the fix's for the same simulated time.
 
   python3 bench/scale.py [--lmp build/fix/lmp_fibre] [--N 10000 100000] [--np 1 2]
                          [--depth 10 | --width W] [--tend 0.5] [--E 1e7] [--L 1]
@@ -82,6 +84,9 @@ def run(lmp, np, method, W, D, tend, check, workdir, E=1e7, L=1.0, dt_fibre=0.00
         contacts = last["f_fc[3]"]
         extra = {"sweeps": last["f_fc[14]"], "estimate": last["f_fc[16]"],
                  "check": last["f_fc[19]"] if check else None}
+        cost = re.search(r"^SCALE sweep_seconds (\S+) contact_sweeps (\S+)", text, re.M)
+        if cost and float(cost.group(2)) > 0:  # a process's sweep time per contact-sweep
+            extra["sweep_ns"] = 1e9 * float(cost.group(1)) * np / float(cost.group(2))
     else:
         contacts = last["c_csum"] / 2.0
         extra = {}
@@ -118,8 +123,8 @@ def main():
     print("| N | np | contacts | fix s / sim s | native s / sim s | native / fix speed | "
           "RSS fix | RSS native | fix bytes / sphere, / contact | "
           "native bytes / sphere, / contact | "
-          "sweeps | estimate | check |")
-    print("|---|---|---|---|---|---|---|---|---|---|---|---|---|")
+          "sweeps | estimate | check | ns / contact-sweep |")
+    print("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|")
     base = {}  # the resident set of a run of 16 spheres, per method and process count
     for np in a.np:
         for m in a.methods:
@@ -144,14 +149,15 @@ def main():
             cell = lambda d, k, fmt, s=1.0: fmt % (s * d[k]) if d and d.get(k) is not None else "-"  # noqa
             ratio = "%.2fx" % (nat["loop"] / f["loop"]) if f and nat else "-"
             atoms = (f or nat or {}).get("atoms", 0)
-            print("| %d | %d | %s | %s | %s | %s | %s | %s | %s, %s | %s, %s | %s | %s | %s |" % (
+            print("| %d | %d | %s | %s | %s | %s | %s | %s | %s, %s | %s, %s | %s | %s | %s | %s |" % (
                 atoms, np, cell(f, "contacts", "%.0f"), cell(f, "per_second", "%.1f"),
                 cell(nat, "per_second", "%.1f"), ratio,
                 cell(f, "rss", "%.0f MB", 1e-6), cell(nat, "rss", "%.0f MB", 1e-6),
                 cell(f, "per_sphere", "%.0f"), cell(f, "per_contact", "%.0f"),
                 cell(nat, "per_sphere", "%.0f"), cell(nat, "per_contact", "%.0f"),
                 cell(f, "sweeps", "%.0f"),
-                cell(f, "estimate", "%.2g"), cell(f, "check", "%.2g")), flush=True)
+                cell(f, "estimate", "%.2g"), cell(f, "check", "%.2g"),
+                cell(f, "sweep_ns", "%.1f")), flush=True)
 
 
 if __name__ == "__main__":
