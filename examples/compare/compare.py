@@ -29,7 +29,7 @@ Subcommands (run from anywhere; paths default to this repository):
       paired by seed with the fix's runs of tag T1 (another setting of the fix, the same
       seeds), and the table gains their difference. With --from-table FILE (a former seeds
       table of this scene) native's figures are that table's and only the fix runs: a rerun
-      of the fix against native runs kept from an earlier session; the table gains the fix's
+      of the fix against native runs kept from an earlier run; the table gains the fix's
       difference from the former table's fix, and its speed line is left out (the twins'
       wall seconds are then of different machines).
   compare.py picture SCENE --N N [--method M] [--when last|filled|STEP] [--out DIR]
