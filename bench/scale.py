@@ -32,7 +32,7 @@ import time
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, os.path.join(HERE, "..", "tools"))
-from lammps_runs import lmp_env, mpi_prefix, parse_thermo  # noqa: E402
+from lammps_runs import MAX_RSS_PREFIX, lmp_env, max_rss_kib, mpi_prefix, parse_thermo  # noqa: E402
 
 
 def collision_time(E, L=1.0, nu=0.3, density=2500.0, v=1.0):
@@ -58,8 +58,8 @@ def run(lmp, np, method, W, D, tend, check, workdir, E=1e7, L=1.0, dt_fibre=0.00
     os.makedirs(workdir, exist_ok=True)
     log = os.path.join(workdir, "log.%s.W%d.np%d" % (method, W, np))
     steps = round(tend / dt_fibre)
-    cmd = mpi_prefix("mpirun", np) + [
-        "/usr/bin/time", "-f", "MAXRSS %M", lmp, "-in", os.path.join(HERE, "scale", "in.bed"),
+    cmd = mpi_prefix("mpirun", np) + MAX_RSS_PREFIX + [
+        lmp, "-in", os.path.join(HERE, "scale", "in.bed"),
         "-log", log, "-echo", "none", "-var", "W", str(W), "-var", "D", str(D),
         "-var", "method", method, "-var", "tend", str(tend), "-var", "E", "%g" % E,
         "-var", "L", "%g" % L, "-var", "dt_fibre", "%g" % dt_fibre, "-var", "fc_extra", keywords,
@@ -78,7 +78,7 @@ def run(lmp, np, method, W, D, tend, check, workdir, E=1e7, L=1.0, dt_fibre=0.00
     rows = parse_thermo(text)[-1]
     last = rows[-1]
     loop = float(re.search(r"Loop time of (\S+)", text).group(1))
-    rss = max(int(k) for k in re.findall(r"MAXRSS (\d+)", out)) * 1024
+    rss = max_rss_kib(out) * 1024
     atoms = int(last["Atoms"])
     if method == "fibre":
         contacts = last["f_fc[3]"]

@@ -8,6 +8,7 @@ numpy arrays itself.
 """
 
 import os
+import re
 import shutil
 
 # The files of an example scene (examples/SCENE/): the fibre_contact deck, its native twin,
@@ -51,6 +52,16 @@ def lmp_env(base=None):
     return env
 
 
+# GNU time in front of the executable (after mpi_prefix: one line a process), and the largest
+# resident set of any process in the run's output, in KiB
+MAX_RSS_PREFIX = ["/usr/bin/time", "-f", "MAXRSS %M"]
+
+
+def max_rss_kib(output):
+    """The largest MAXRSS that MAX_RSS_PREFIX printed in output (KiB)."""
+    return max(int(k) for k in re.findall(r"MAXRSS (\d+)", output))
+
+
 # ----------------------------------------------------------------------------- reading
 
 def read_text(path):
@@ -90,6 +101,12 @@ def thermo_blocks(text):
 def parse_thermo(text):
     """Thermo blocks of a LAMMPS log's text: a list (one per run) of lists of {column: value}."""
     return [[dict(zip(header, r)) for r in rows] for header, rows in thermo_blocks(text)]
+
+
+def least_squares_slope(xs, ys):
+    """The slope of the least-squares line through the points (xs, ys)."""
+    xm, ym = sum(xs) / len(xs), sum(ys) / len(ys)
+    return sum((x - xm) * (y - ym) for x, y in zip(xs, ys)) / sum((x - xm) ** 2 for x in xs)
 
 
 def last_line_words(text, prefix):

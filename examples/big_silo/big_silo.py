@@ -18,26 +18,18 @@ import sys
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, os.path.join(HERE, "..", "..", "tools"))
-from lammps_runs import lmp_env, mpi_prefix, parse_thermo  # noqa: E402
-
-
-def fit_rate(times, counts):
-    """The slope of a least-squares line through (time, count): spheres per second."""
-    n = len(times)
-    mt, mc = sum(times) / n, sum(counts) / n
-    stt = sum((t - mt) ** 2 for t in times)
-    return sum((t - mt) * (c - mc) for t, c in zip(times, counts)) / stt
+from lammps_runs import (MAX_RSS_PREFIX, least_squares_slope, lmp_env,  # noqa: E402
+                         max_rss_kib, mpi_prefix, parse_thermo)
 
 
 def run(lmp, method, workdir, np=1, R=30, H=72, Do=8.0, tsettle=2.5, tflow=1.5, tskip=0.4):
     """One twin's run in workdir; its figures (a dict), or None where it failed."""
     os.makedirs(workdir, exist_ok=True)
     log = os.path.join(workdir, "log.big_silo.%s" % method)
-    cmd = mpi_prefix("mpirun", np) + [
-        "/usr/bin/time", "-f", "MAXRSS %M", lmp, "-in", os.path.join(HERE, "in.big_silo"),
-        "-log", log, "-echo", "none", "-var", "method", method, "-var", "R", "%g" % R,
-        "-var", "H", "%g" % H, "-var", "Do", "%g" % Do, "-var", "tsettle", "%g" % tsettle,
-        "-var", "tflow", "%g" % tflow]
+    cmd = mpi_prefix("mpirun", np) + MAX_RSS_PREFIX + [
+        lmp, "-in", os.path.join(HERE, "in.big_silo"), "-log", log, "-echo", "none",
+        "-var", "method", method, "-var", "R", "%g" % R, "-var", "H", "%g" % H,
+        "-var", "Do", "%g" % Do, "-var", "tsettle", "%g" % tsettle, "-var", "tflow", "%g" % tflow]
     proc = subprocess.run(cmd, cwd=workdir, stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
                           env=lmp_env())
     out = proc.stdout.decode("utf-8", "replace")
@@ -55,9 +47,10 @@ def run(lmp, method, workdir, np=1, R=30, H=72, Do=8.0, tsettle=2.5, tflow=1.5, 
         "left": int(flow[-1]["Atoms"]),
         "inside": int(flow[-1]["v_inside"]), "zmax": float(settled.group(1)),
         "zcm": float(settled.group(2)),
-        "rate": -fit_rate([r["Time"] for r in window], [r["v_inside"] for r in window]),
+        "rate": -least_squares_slope([r["Time"] for r in window],
+                                     [r["v_inside"] for r in window]),
         "loop": sum(loops), "sim": flow[-1]["Time"],
-        "rss": max(int(m) for m in re.findall(r"MAXRSS (\d+)", out)) / 1024.0}
+        "rss": max_rss_kib(out) / 1024.0}
     if method == "fibre":
         figures["contacts"] = int(flow[-1]["f_fc[3]"])
         figures["sweeps"] = max(int(r["f_fc[14]"]) for r in settle + flow)

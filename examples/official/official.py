@@ -20,7 +20,7 @@ import time
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, os.path.join(HERE, "..", "..", "tools"))
-from lammps_runs import lmp_env, mpi_prefix, parse_thermo  # noqa: E402
+from lammps_runs import least_squares_slope, lmp_env, mpi_prefix, parse_thermo  # noqa: E402
 
 EXAMPLES = "/usr/share/lammps/examples"
 LIGGGHTS_EXAMPLES = "/usr/share/doc/liggghts/examples/LIGGGHTS/Tutorials_public"
@@ -146,9 +146,7 @@ def funnel_figures(run):
         # the least-squares slope of the grains left against time over the window
         t = [r["Step"] * float(step.group(1)) for r in window]
         n = [r["Atoms"] for r in window]
-        tm, nm = sum(t) / len(t), sum(n) / len(n)
-        slope = sum((a - tm) * (b - nm) for a, b in zip(t, n)) / sum((a - tm) ** 2 for a in t)
-        out["rate"] = -slope
+        out["rate"] = -least_squares_slope(t, n)
     return out
 
 
