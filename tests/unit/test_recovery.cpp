@@ -79,7 +79,7 @@ TEST(Recovery, AnIsolatedPairOpensByAStepOfTheRecoverySpeed)
   const std::vector<Body> bodies{sphere(0.0, 1.0), sphere(0.8, 3.0)};
   const std::vector<Contact> contacts = modelled(bodies, {sphere_sphere_contact(bodies, 1, 0)});
   ASSERT_NEAR(contacts[0].penetration, 0.2, 1e-12);
-  const ContactSystem sys(bodies, contacts, 6, params());
+  ContactSystem sys(bodies, contacts, 6, params());
   Vector dx;
   ASSERT_EQ(
       recovery_displacement(sys, serial_exchange(), at_rest(bodies), sys.params().h, dx).outcome,
@@ -101,7 +101,7 @@ TEST(Recovery, AShallowOverlapIsLeftToTheRows)
   const std::vector<Body> bodies{sphere(0.0, 1.0), sphere(0.98, 1.0)};
   const std::vector<Contact> contacts = modelled(bodies, {sphere_sphere_contact(bodies, 1, 0)});
   EXPECT_EQ(contacts[0].penetration, 0.0);
-  const ContactSystem sys(bodies, contacts, 6, params());
+  ContactSystem sys(bodies, contacts, 6, params());
   Vector dx;
   EXPECT_EQ(
       recovery_displacement(sys, serial_exchange(), at_rest(bodies), sys.params().h, dx).outcome,
@@ -118,7 +118,7 @@ TEST(Recovery, ACagedSphereIsNotMoved)
                                 sphere_wall_contact(bodies, 0, -Vec3::UnitX(), 0.4)};
   contacts = modelled(bodies, contacts);
   ASSERT_GT(contacts[0].penetration, 0.0);
-  const ContactSystem sys(bodies, contacts, 6, params());
+  ContactSystem sys(bodies, contacts, 6, params());
   Vector dx;
   const Recovery recovery =
       recovery_displacement(sys, serial_exchange(), at_rest(bodies), sys.params().h, dx);
@@ -143,7 +143,7 @@ TEST(Recovery, AJammedRowIsNotMoved)
   // 2.6 between the walls for three diameters: every opening closes another contact as much
   // (a jammed pack), and the displacement is refused
   const std::vector<Body> bodies{sphere(0.0, 1.0), sphere(0.9, 1.0), sphere(1.8, 1.0)};
-  const ContactSystem sys(bodies, row_of_three(bodies, true), 6, params());
+  ContactSystem sys(bodies, row_of_three(bodies, true), 6, params());
   Vector dx;
   const Recovery recovery =
       recovery_displacement(sys, serial_exchange(), at_rest(bodies), sys.params().h, dx);
@@ -156,7 +156,7 @@ TEST(Recovery, ARowWithRoomOpens)
 {
   // without the right wall the row slides right: every penetration opens, none closes
   const std::vector<Body> bodies{sphere(0.0, 1.0), sphere(0.9, 1.0), sphere(1.8, 1.0)};
-  const ContactSystem sys(bodies, row_of_three(bodies, false), 6, params());
+  ContactSystem sys(bodies, row_of_three(bodies, false), 6, params());
   Vector dx;
   ASSERT_EQ(
       recovery_displacement(sys, serial_exchange(), at_rest(bodies), sys.params().h, dx).outcome,
@@ -173,14 +173,18 @@ TEST(Recovery, AnElasticPenetrationOpensAsARigidRow)
   const std::vector<Contact> contacts = material(bodies, {sphere_sphere_contact(bodies, 1, 0)});
   ASSERT_TRUE(contacts[0].elastic[0]);
   ASSERT_NEAR(contacts[0].penetration, 0.2, 1e-12); // the whole overlap: no load explains it
-  const ContactSystem sys(bodies, contacts, 6, params());
+  ContactSystem sys(bodies, contacts, 6, params());
   const double w = 4.0 / 3.0;
   ASSERT_GT(sys.sigma()[0], 2 * w); // the law's row alone would keep most of the opening
   EXPECT_EQ(sys.params().gap_term(sys.contacts()[0], sys.params().upsilon()), 0.0); // no push
+  const Vector sigma = sys.sigma();
   Vector dx;
   ASSERT_EQ(
       recovery_displacement(sys, serial_exchange(), at_rest(bodies), sys.params().h, dx).outcome,
       Recovery::Outcome::opened);
+  // the rows are rigid only during the solve: the law's compliance and Sigma come back exactly
+  EXPECT_EQ(sys.contacts()[0].compliance[0], contacts[0].compliance[0]);
+  EXPECT_TRUE((sys.sigma().array() == sigma.array()).all());
   // the rows rigid for the displacement (Sigma below 1e-4 w): a step of max_recovery, 3 : 1
   const double open = dx[6] - dx[0];
   EXPECT_NEAR(open, 0.005, 0.005 * 1e-4);
@@ -203,7 +207,7 @@ TEST(Recovery, AKnownElasticPenetrationLeavesTheClosingToTheSpring)
   const std::vector<Contact> contacts = material(bodies, {c});
   EXPECT_EQ(contacts[0].penetration, 0.1);
   EXPECT_TRUE(contacts[0].split);
-  const ContactSystem sys(bodies, contacts, 6, params());
+  ContactSystem sys(bodies, contacts, 6, params());
   const SpookParams &p = sys.params();
   EXPECT_NEAR(p.gap_term(sys.contacts()[0], p.upsilon()), 4.0 / p.h * p.upsilon() * 0.1, 1e-9);
 }

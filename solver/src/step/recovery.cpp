@@ -1,7 +1,6 @@
 #include "fibre/step/recovery.hpp"
 
 #include <algorithm>
-#include <memory>
 
 #include "fibre/algebra/cones.hpp"
 #include "fibre/algebra/kernels.hpp"
@@ -36,24 +35,49 @@ Vector recovery_rhs(const ContactSystem &sys, const Vector &Gv, double span)
   return b;
 }
 
-// The system with its elastic normal rows rigid, or null where it has none: the displacement
+// The system's elastic normal rows made rigid, in place, for the displacement's solve, and
+// restored (compliances, Sigma and row mask bit for bit) when this goes: the displacement
 // neither compresses a law's spring (a caged sphere's neighbours, pushed into theirs, stored
 // the energy that threw the cage apart at 11 m/s) nor leaves Sigma's share of a penetration's
 // opening. A rigid row's Sigma is 1e-4 of its G M^-1 G^T (compliance auto's is about 0.01).
-std::unique_ptr<ContactSystem> rigid_rows(const ContactSystem &sys)
-{
-  const std::vector<Contact> &contacts = sys.contacts();
-  if (std::none_of(contacts.begin(), contacts.end(), [](const Contact &c) { return c.elastic[0]; }))
-    return nullptr;
-  const double h = sys.params().h;
-  std::vector<Contact> rigid = contacts;
-  for (std::size_t c = 0; c < rigid.size(); ++c) {
-    const std::array<Vec6, 2> &sides = sys.diagonal_sides(static_cast<int>(c));
-    if (rigid[c].elastic[0]) rigid[c].compliance[0] = 1e-4 * h * h * (sides[0][0] + sides[1][0]);
+// In place, not a copy: a copy of the system (its contacts, kinematics and bodies) was a
+// third of a settling silo's peak heap.
+class RigidNormalRows {
+ public:
+  explicit RigidNormalRows(ContactSystem &sys) : sys_(sys)
+  {
+    const std::vector<Contact> &contacts = sys.contacts();
+    if (std::none_of(contacts.begin(), contacts.end(),
+                     [](const Contact &c) { return c.elastic[0]; }))
+      return;
+    mask_ = sys.row_mask();
+    if (!mask_.empty()) sys.set_row_mask(std::vector<unsigned char>(sys.contact_dofs(), 1));
+    const double h = sys.params().h;
+    saved_.resize(contacts.size());
+    sys.edit_compliances([&](std::vector<Contact> &edit) {
+      for (std::size_t c = 0; c < edit.size(); ++c) {
+        saved_[c] = edit[c].compliance[0];
+        const std::array<Vec6, 2> &sides = sys.diagonal_sides(static_cast<int>(c));
+        if (edit[c].elastic[0]) edit[c].compliance[0] = 1e-4 * h * h * (sides[0][0] + sides[1][0]);
+      }
+    });
   }
-  return std::make_unique<ContactSystem>(sys.bodies(), std::move(rigid), sys.rows(), sys.params(),
-                                         sys.num_owned_bodies());
-}
+  ~RigidNormalRows()
+  {
+    if (saved_.empty()) return;
+    sys_.edit_compliances([this](std::vector<Contact> &edit) {
+      for (std::size_t c = 0; c < edit.size(); ++c) edit[c].compliance[0] = saved_[c];
+    });
+    if (!mask_.empty()) sys_.set_row_mask(mask_);
+  }
+  RigidNormalRows(const RigidNormalRows &) = delete;
+  RigidNormalRows &operator=(const RigidNormalRows &) = delete;
+
+ private:
+  ContactSystem &sys_;
+  std::vector<double> saved_;
+  std::vector<unsigned char> mask_;
+};
 
 // Whether the displacement dx closes other contacts (an open one beyond its gap after the step,
 // a touching or split one at all) by at least kShuffle of what it opens of the split
@@ -94,24 +118,25 @@ long split_penetrations(const ContactSystem &sys, const Exchange &ex)
   return static_cast<long>(count);
 }
 
-Recovery recovery_displacement(const ContactSystem &sys, const Exchange &ex, const Vector &v_plus,
+Recovery recovery_displacement(ContactSystem &sys, const Exchange &ex, const Vector &v_plus,
                                double span, Vector &dx, int max_sweeps)
 {
   Recovery recovery;
   recovery.split = split_penetrations(sys, ex);
   if (recovery.split == 0) return recovery;
-  const std::unique_ptr<ContactSystem> rigid = rigid_rows(sys);
-  const ContactSystem &solved = rigid ? *rigid : sys;
-  const Cones frictionless = Cones::frictionless(solved);
   Vector Gv;
   g_apply(sys, v_plus, Gv);
   const Vector b = recovery_rhs(sys, Gv, span);
-  Vector mu = Vector::Zero(sys.contact_dofs());
-  PgsControl control;
-  control.max_sweeps = max_sweeps;
-  control.tol = 1e-3;
-  pgs(solved, ex, frictionless, b, row_scales(solved), mu, control);
-  dx = velocity_change(solved, ex, mu);
+  {
+    const RigidNormalRows rigid(sys);
+    const Cones frictionless = Cones::frictionless(sys);
+    Vector mu = Vector::Zero(sys.contact_dofs());
+    PgsControl control;
+    control.max_sweeps = max_sweeps;
+    control.tol = 1e-3;
+    pgs(sys, ex, frictionless, b, row_scales(sys), mu, control);
+    dx = velocity_change(sys, ex, mu);
+  }
   const double reach = span * sys.params().max_recovery;
   double fastest = 0.0;
   for (int i = 0; i < sys.num_bodies(); ++i) {

@@ -334,6 +334,13 @@ class ContactSystem {
     compute_rows();
     velocity_rows_ = std::move(velocity_rows);
   }
+  // The contacts' compliances and damping changed in place by `edit` (nothing else of them):
+  // Sigma follows; the kinematics, the rhs and velocity_rows hold.
+  template <typename Edit> void edit_compliances(Edit &&edit)
+  {
+    edit(contacts_);
+    compute_rows();
+  }
   // G v of the bodies' velocities, every row active, where known (a substep after the first:
   // next_substep), else empty.
   const Vector &velocity_rows() const { return velocity_rows_; }

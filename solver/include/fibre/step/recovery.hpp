@@ -39,8 +39,8 @@ struct Recovery {
 // most of what it opens (a jammed pack, more spheres than its box holds) is not taken: dx is
 // zero, and the penetrations stay until there is room. span is the step the displacement is
 // taken over: the system's h, or the whole step where the system is its last substep's.
-// Collective.
-Recovery recovery_displacement(const ContactSystem &sys, const Exchange &ex, const Vector &v_plus,
+// sys's elastic normal rows are rigid during the solve and restored on return. Collective.
+Recovery recovery_displacement(ContactSystem &sys, const Exchange &ex, const Vector &v_plus,
                                double span, Vector &dx, int max_sweeps = 100);
 
 // An elastic row's penetration left after the displacement dx: springs[c][0] (the penetration
