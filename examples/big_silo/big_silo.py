@@ -22,7 +22,7 @@ from lammps_runs import (MAX_RSS_PREFIX, least_squares_slope, lmp_env,  # noqa: 
                          max_rss_kib, mpi_prefix, parse_thermo)
 
 
-def run(lmp, method, workdir, np=1, R=30, H=72, Do=8.0, tsettle=2.5, tflow=1.5, tskip=0.4):
+def run(lmp, method, workdir, np=1, R=30, H=72, Do=8.0, tsettle=4.0, tflow=1.5, tskip=0.4):
     """One twin's run in workdir; its figures (a dict), or None where it failed."""
     os.makedirs(workdir, exist_ok=True)
     log = os.path.join(workdir, "log.big_silo.%s" % method)
@@ -64,7 +64,7 @@ def main():
     p.add_argument("--R", type=float, default=30, help="the bin's radius")
     p.add_argument("--H", type=float, default=72, help="the top of the fill")
     p.add_argument("--Do", type=float, default=8.0, help="the orifice's diameter")
-    p.add_argument("--tsettle", type=float, default=2.5)
+    p.add_argument("--tsettle", type=float, default=4.0)
     p.add_argument("--tflow", type=float, default=1.5)
     p.add_argument("--tskip", type=float, default=0.4, help="the rate's fit starts this late")
     p.add_argument("--np", type=int, default=1)
