@@ -123,8 +123,9 @@ def main():
                      "%.2g m, %.2g m/s; non-converged steps %g and %g" % (dx, dv, failed[1],
                                                                          failed[2]))
         if label == "adaptive":
-            # the sweeps hand the slow collision steps over to the linear pass (3 of 60 at np 1
-            # and 2), alike on both process counts: the decision reads global norms
+            # the first step (a cold start) and the slow collision steps go to the linear pass
+            # (4 of 60 at np 1 and 2), alike on both process counts: the decision reads global
+            # norms
             ck.check(handed[1] > 0 and handed[1] == handed[2],
                      "adaptive: the same steps handed over to the linear pass at np 1 and 2",
                      "%g and %g" % (handed[1], handed[2]))
