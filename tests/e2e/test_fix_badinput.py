@@ -46,7 +46,7 @@ CASES = [
     ("form_invalid", "form primal", "expected 'form body|contact', got 'primal'", {}),
     ("form_missing", "form", "expected 'form body|contact'", {}),
     # the choices are Method's name table: cg (uzawa an accepted alias), cr, minres, direct, pgs
-    ("solver_invalid", "solver bicgstab", "expected 'solver cg|cr|minres|direct|pgs|nncg|fbgs|apgd|adaptive', got "
+    ("solver_invalid", "solver bicgstab", "expected 'solver cg|cr|minres|direct|pgs|nncg|fbgs|apgd', got "
      "'bicgstab'", {}),
     ("precond_invalid", "precond ilu", "expected 'precond none|jacobi|block|fibre|tree', got "
      "'ilu'", {}),

@@ -207,7 +207,7 @@ TEST(Settings, BadInputNamesTheKeywordAndItsForm)
 {
   EXPECT_EQ(error_of("form primal"), "expected 'form body|contact', got 'primal'");
   EXPECT_EQ(error_of("solver bicgstab"),
-            "expected 'solver cg|cr|minres|direct|pgs|nncg|fbgs|apgd|adaptive', got 'bicgstab'");
+            "expected 'solver cg|cr|minres|direct|pgs|nncg|fbgs|apgd', got 'bicgstab'");
   EXPECT_EQ(error_of("precond"), "expected 'precond none|jacobi|block|fibre|tree'");
   EXPECT_EQ(error_of("tol -1"), "expected 'tol none|<positive number>', got '-1'");
   EXPECT_EQ(error_of("tol 1e-3x"), "expected 'tol none|<positive number>', got '1e-3x'");

@@ -209,12 +209,6 @@ bool sweeps_only(const Settings &s)
   return !linear_pass(s);
 }
 
-// The sweeps end the step (solver adaptive's after its linear pass too).
-bool sweeps_end(const Settings &s)
-{
-  return sweeps_only(s) || s.step.solver == Method::adaptive;
-}
-
 std::string quoted(const std::string &key, const std::string &form)
 {
   return "'" + key + " " + form + "'";
@@ -461,7 +455,7 @@ std::vector<Keyword> linear_keywords()
          st.s.step.rescue_sweeps = count(in, i + 1, e, 0, 1000000);
          return 2;
        },
-       [](const Settings &s) { return sweeps_end(s) || s.step.accuracy > 0; },
+       [](const Settings &s) { return sweeps_only(s) || s.step.accuracy > 0; },
        "outside a linear pass with tol none"},
   };
 }
@@ -484,7 +478,7 @@ std::vector<Keyword> sweep_keywords()
          return 2;
        },
        // (after a linear pass it also decides whether the sweeps restart from the warm start)
-       [](const Settings &s) { return s.step.accuracy > 0 && sweeps_end(s); },
+       [](const Settings &s) { return s.step.accuracy > 0 && sweeps_only(s); },
        "with a tol and no linear pass (the sweeps stop on the tol's error estimate)"},
       {{"min_sweeps", T, quoted("min_sweeps", "<non-negative integer>"),
         "the sweeps before a tol may stop them"},

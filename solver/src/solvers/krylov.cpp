@@ -352,7 +352,6 @@ SolveResult krylov_solve(Method m, const LinearOperator &A, const Preconditioner
   case Method::nncg:
   case Method::fbgs:
   case Method::apgd:
-  case Method::adaptive:
     break;
   }
   throw std::invalid_argument(std::string("krylov_solve: ") + to_string(m) +

@@ -511,10 +511,6 @@ bool PgsRun::sweep(int s)
     combination_ = anderson_.combined();
   }
   if (stop_rule(full, norms) || stalled()) return true;
-  if (full && control_.hand_over && control_.hand_over(res_)) {
-    res_.handed_over = true;
-    return true;
-  }
   if (control_.nonlinear_cg && s + 1 < control_.max_sweeps) cg_step(s, norms[0]);
   return false;
 }

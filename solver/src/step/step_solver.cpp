@@ -27,11 +27,6 @@ std::string describe(const StepOptions &opt)
          std::to_string(opt.min_sweeps) + ", focus_sweeps " + std::to_string(opt.focus_sweeps) +
          ", anderson " + std::to_string(opt.anderson) +
          (opt.anderson > 0 ? ", anderson_period " + std::to_string(opt.anderson_period) : "") +
-         (opt.solver == Method::adaptive
-              ? " (hand over from sweep " + std::to_string(opt.probe_sweeps) +
-                    ", from a cold start 11, when over " + g(opt.hand_over_sweeps) +
-                    " more are predicted)"
-              : "") +
          (opt.sweep_cg ? ", sweep_cg yes" : "") + (opt.sweep_blocks ? ", sweep_blocks yes" : "") +
          (opt.sweep_groups ? "" : ", sweep_groups no");
 }
@@ -57,7 +52,7 @@ class StepSolver {
   StepSolver(ContactSystem &sys, const Exchange &ex, const StepOptions &opt, MPI_Comm comm,
              SweepCache *cache)
       : sys_(sys), ex_(ex), opt_(opt), comm_(comm), cache_(cache), rows_(sys.rows()),
-        nc_(sys.num_contacts()), cones_(sys), state_(linear_first() ? nc_ : 0),
+        nc_(sys.num_contacts()), cones_(sys), state_(sweeps_only() ? 0 : nc_),
         all_rows_(sys.contact_dofs(), 1)
   {
   }
@@ -67,19 +62,13 @@ class StepSolver {
  private:
   Vector initial_impulses(const Vector *warm);
   void active_set_loop(Vector &lambda, StepResult &res);
-  void adaptive(Vector &lambda, StepResult &res);
-  bool slow(const PgsResult &p) const;
-  bool cold(const Vector &lambda) const;
 
   double coeff(int c, int k) const { return cones_.coeff(c, k); }
-  // The sweeps are the whole solve the user asked for (adaptive: unless handed over).
   bool sweeps_only() const
   {
     return opt_.solver == Method::pgs || opt_.solver == Method::nncg ||
-           opt_.solver == Method::fbgs || opt_.solver == Method::apgd ||
-           opt_.solver == Method::adaptive;
+           opt_.solver == Method::fbgs || opt_.solver == Method::apgd;
   }
-  bool linear_first() const { return !sweeps_only(); }
   Eigen::Index base(int c) const { return Eigen::Index(rows_) * c; }
   std::vector<unsigned char> active_mask() const;
   Vector fixed_impulses(const Vector &lambda) const;
@@ -87,7 +76,7 @@ class StepSolver {
                       StepResult &res);
   int update_set(const Vector &lambda, const std::vector<unsigned char> &mask);
   void project(Vector &lambda) const;
-  void finish(Vector &lambda, StepResult &res, int max_sweeps, bool probe = false) const;
+  void finish(Vector &lambda, StepResult &res) const;
   void count_set(const Vector &lambda, StepResult &res) const;
 
   ContactSystem &sys_;
@@ -103,7 +92,6 @@ class StepSolver {
   std::vector<Vec6> row_scales_; // the sweeps' and residuals' row scales, every row active
   std::vector<Vec6> diagonal_;   // A_ii per contact, every row active
   StopReason last_reason_ = StopReason::converged;
-  int probe_sweeps_ = 0; // Method::adaptive: slow() asks from this sweep on
 };
 
 std::vector<unsigned char> StepSolver::active_mask() const
@@ -176,7 +164,7 @@ Vector StepSolver::linear_solve(const Vector &b, const Vector &warm, const StopC
     res.setup_seconds += seconds_since(t0);
     const auto t1 = Clock::now();
     const auto A = make_operator(opt_.form, sys_, ex_);
-    const Method m = opt_.solver == Method::adaptive ? Method::cg : opt_.solver;
+    const Method m = opt_.solver;
     if (opt_.form == Form::contact) {
       lambda = warm;
       sr = krylov_solve(m, *A, *P, b, lambda, stop);
@@ -295,7 +283,7 @@ void StepSolver::project(Vector &lambda) const
 // Projected Gauss-Seidel on the full system while the impulses are not accurate enough:
 // they finish what the active-set loop leaves (an unsettled set, caps from a lagged l_n, a
 // loose last pass), or do the whole solve (Method::pgs).
-void StepSolver::finish(Vector &lambda, StepResult &res, int max_sweeps, bool probe) const
+void StepSolver::finish(Vector &lambda, StepResult &res) const
 {
   const auto t_sweep = Clock::now();
   const std::vector<Vec6> &scale = row_scales_;
@@ -303,18 +291,18 @@ void StepSolver::finish(Vector &lambda, StepResult &res, int max_sweeps, bool pr
   res.sweep_equivalents = 0;
   const bool accuracy = opt_.accuracy > 0;
   // Under the accuracy rule the sweeps run whatever the residual, and measure it after.
-  if (!accuracy || max_sweeps <= 0) {
+  if (!accuracy || opt_.sweeps <= 0) {
     res.complementarity = complementarity(sys_, ex_, cones_, b_full_, lambda, scale);
     res.error_estimate = res.complementarity;
   }
-  if (max_sweeps > 0 && (accuracy || res.complementarity > opt_.sweep_tol)) {
-    PgsControl control{max_sweeps, opt_.sweep_tol};
+  if (opt_.sweeps > 0 && (accuracy || res.complementarity > opt_.sweep_tol)) {
+    PgsControl control{opt_.sweeps, opt_.sweep_tol};
     control.accuracy = opt_.accuracy;
     // Under the accuracy rule only the cap ends a step that has not converged: on a stiff
     // pile the change per sweep can stop falling for a thousand sweeps while a wedged sphere
     // works its way out, and then fall to the tol (bench/README.md, "The stiff decks'
     // stagnating steps").
-    if (accuracy) control.stall_sweeps = std::max(max_sweeps, 1);
+    if (accuracy) control.stall_sweeps = std::max(opt_.sweeps, 1);
     control.min_sweeps = opt_.min_sweeps;
     control.focus_sweeps = opt_.focus_sweeps;
     control.anderson = opt_.anderson;
@@ -324,7 +312,6 @@ void StepSolver::finish(Vector &lambda, StepResult &res, int max_sweeps, bool pr
     control.fibre_blocks = opt_.sweep_blocks || opt_.solver == Method::fbgs;
     control.block_weight = opt_.precond.weight;
     control.cache = cache_;
-    if (probe) control.hand_over = [this](const PgsResult &p) { return slow(p); };
     // the residual decides the rescue and the restart, except under the accuracy rule with a
     // sweeps-only solver
     const bool measured = opt_.residual || !accuracy || !sweeps_only();
@@ -335,7 +322,6 @@ void StepSolver::finish(Vector &lambda, StepResult &res, int max_sweeps, bool pr
       res.sweeps += pr.sweeps;
       res.sweep_equivalents += nc_ > 0 ? double(pr.visits) / nc_ : 0.0;
       res.sweep_reason = pr.reason;
-      res.preconditioned = pr.handed_over ? 1 : 0;
       res.error_estimate = pr.reported_estimate();
       res.complementarity =
           measured ? complementarity(sys_, ex_, cones_, b_full_, lambda, scale) : kNotMeasured;
@@ -440,63 +426,6 @@ void StepSolver::active_set_loop(Vector &lambda, StepResult &res)
   }
 }
 
-// Whether the sweeps are slow (Method::adaptive): past probe_sweeps_, the sweeps that they still
-// need to reach the accuracy exceed hand_over_sweeps, counted from where they stand and how
-// fast their changes fell over the last kRateSweeps sweeps (an even number: Anderson mixes
-// after every other sweep). Every process sees the same changes (global norms).
-bool StepSolver::slow(const PgsResult &p) const
-{
-  constexpr int kRateSweeps = 10;
-  const int s = static_cast<int>(p.changes.size());
-  if (s < std::max(probe_sweeps_, kRateSweeps + 1)) return false;
-  const double now = p.changes[s - 1], then = p.changes[s - 1 - kRateSweeps];
-  if (!(now > 0)) return false;
-  const double rate = then > 0 ? std::pow(now / then, 1.0 / kRateSweeps) : 1.0;
-  if (!(rate < 1)) return true;
-  const double estimate = std::min(p.error_estimate(), now * rate / (1 - rate));
-  if (!(estimate > opt_.accuracy)) return false;
-  return std::log(opt_.accuracy / estimate) / std::log(rate) > opt_.hand_over_sweeps;
-}
-
-// A cold start: the warm start carries no normal impulse on at least kColdFraction of the
-// contacts (all processes), as at a run's first step or a take-over of a state made elsewhere.
-bool StepSolver::cold(const Vector &lambda) const
-{
-  constexpr double kColdFraction = 0.9;
-  double counts[2] = {0, double(nc_)};
-  for (int c = 0; c < nc_; ++c) counts[0] += lambda[base(c)] == 0.0;
-  ex_.sum(counts, 2);
-  return counts[1] > 0 && counts[0] >= kColdFraction * counts[1];
-}
-
-// Method::adaptive: the sweeps, and where slow() finds them slow the cg path (the set from
-// trial impulses, the linear pass, sweeps to finish) from their impulses, or from a cold
-// start's own, asked from sweep 11 on: on a take-over of a native pile the sweeps took 483,
-// the cg path from the start 289 and 37 CG iterations, and from the sweeps' 30th 527 and 23;
-// the impacts of a pour's new contacts, also cold, take fewer than 11.
-void StepSolver::adaptive(Vector &lambda, StepResult &res)
-{
-  const bool from_cold = cold(lambda);
-  const Vector start = from_cold ? lambda : Vector();
-  probe_sweeps_ = from_cold ? 0 : opt_.probe_sweeps;
-  finish(lambda, res, opt_.sweeps, opt_.accuracy > 0);
-  if (res.preconditioned == 0) return;
-  if (from_cold) lambda = start;
-  state_.assign(nc_, ContactState{});
-  update_set(lambda, std::vector<unsigned char>(sys_.contact_dofs(), 0));
-  active_set_loop(lambda, res);
-  project(lambda);
-  if (last_reason_ == StopReason::non_finite) return;
-  StepResult after = res;
-  finish(lambda, after, std::max(opt_.sweeps - res.sweeps, 1));
-  res.sweeps += after.sweeps;
-  res.sweep_equivalents += after.sweep_equivalents;
-  res.sweep_seconds += after.sweep_seconds;
-  res.sweep_reason = after.sweep_reason;
-  res.error_estimate = after.error_estimate;
-  res.complementarity = after.complementarity;
-}
-
 StepResult StepSolver::run(const Vector *warm)
 {
   const auto t_start = Clock::now();
@@ -521,16 +450,13 @@ StepResult StepSolver::run(const Vector *warm)
   // (Projecting an unsettled pass alone could zero a tensile impulse that balances large
   // compressive ones and kick the bodies between them: 29 m/s in one silo step.)
   project(lambda);
-  if (opt_.solver == Method::adaptive)
-    adaptive(lambda, res);
-  else if (last_reason_ != StopReason::non_finite)
-    finish(lambda, res, opt_.sweeps);
+  if (last_reason_ != StopReason::non_finite) finish(lambda, res);
   // A pass whose projection the sweeps could not repair (a jammed pack under a moving wall:
   // residual 1.45 from a warm start at 0.04, bodies thrown at 70 m/s): sweep from the warm
   // start instead, and keep the better of the two.
   if (!sweeps_only() && !(res.complementarity <= std::max(start_residual, opt_.sweep_tol))) {
     StepResult again = res;
-    finish(start, again, opt_.sweeps);
+    finish(start, again);
     res.sweeps += again.sweeps;
     res.sweep_equivalents += again.sweep_equivalents;
     res.sweep_seconds += again.sweep_seconds;

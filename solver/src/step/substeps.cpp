@@ -50,7 +50,6 @@ void add_solve(StepResult &into, const StepResult &more)
   if (into.reason == StopReason::converged) into.reason = more.reason;
   into.rescued = into.rescued || more.rescued;
   into.restarted = into.restarted || more.restarted;
-  into.preconditioned += more.preconditioned;
   into.error_estimate = std::max(into.error_estimate, more.error_estimate);
   into.complementarity = std::max(into.complementarity, more.complementarity);
   into.setup_seconds += more.setup_seconds;

@@ -117,7 +117,6 @@ StudyRow measure_setting(const StepState &state, const StepOptions &opt, const V
   row.complementarity = res.complementarity;
   row.error_estimate = res.error_estimate;
   row.converged = res.converged;
-  row.preconditioned = res.preconditioned;
   row.error = step_accuracy(state.sys, res.lambda, reference, state.exchange());
   return row;
 }

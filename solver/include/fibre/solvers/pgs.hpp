@@ -6,7 +6,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <functional>
 #include <vector>
 
 #include "fibre/algebra/cones.hpp"
@@ -16,8 +15,6 @@
 #include "fibre/solvers/sweep_groups.hpp"
 
 namespace fibre {
-
-struct PgsResult;
 
 // Stop when a sweep moves lambda by at most tol relative to |lambda| (2-norms over all
 // processes), or, with accuracy > 0, when the estimated remaining error of the impulses
@@ -62,9 +59,6 @@ struct PgsControl {
   // The groups of the sweeps kept from one solve of a system's kinematics to the next (the
   // substeps of a step) and rebuilt for other kinematics; null: built for this solve alone.
   SweepCache *cache = nullptr;
-  // Asked after every full sweep that did not end the sweeps, with the result so far (alike on
-  // every process); true ends them (PgsResult::handed_over): another method takes over.
-  std::function<bool(const PgsResult &)> hand_over = nullptr;
 };
 
 inline constexpr int kRateWindow = 5;
@@ -119,7 +113,6 @@ struct PgsResult {
   double met_estimate = INFINITY;
   double reported_estimate() const { return std::min(error_estimate(), met_estimate); }
   bool converged() const { return reason == StopReason::converged; }
-  bool handed_over = false; // PgsControl::hand_over ended the sweeps
 };
 
 // Sweeps from lambda (feasible or not; it is projected contact by contact). `sys` must have

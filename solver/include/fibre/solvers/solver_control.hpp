@@ -18,22 +18,15 @@ namespace fibre {
 //   pgs     projected Gauss-Seidel on the nonsmooth problem alone (no linear pass);
 //   nncg    the same sweeps accelerated by nonsmooth nonlinear CG (pgs.hpp);
 //   fbgs    the same sweeps with fibre-block corrections (fibre_blocks.hpp);
-//   apgd    accelerated projected gradient descent on the nonsmooth problem (apgd.hpp);
-//   adaptive  pgs's sweeps, handed over to the cg path (the tree-preconditioned linear pass on
-//           the sweeps' active set, then sweeps) when they are predicted to be slow.
-enum class Method { cg, cr, minres, direct, pgs, nncg, fbgs, apgd, adaptive };
+//   apgd    accelerated projected gradient descent on the nonsmooth problem (apgd.hpp).
+enum class Method { cg, cr, minres, direct, pgs, nncg, fbgs, apgd };
 template <> struct EnumNames<Method> {
-  static constexpr EnumName<Method> table[] = {{Method::cg, "cg"},
-                                               {Method::cr, "cr"},
-                                               {Method::minres, "minres"},
-                                               {Method::direct, "direct"},
-                                               {Method::pgs, "pgs"},
-                                               {Method::nncg, "nncg"},
-                                               {Method::fbgs, "fbgs"},
-                                               {Method::apgd, "apgd"},
-                                               {Method::adaptive, "adaptive"},
-                                               {Method::cg, "uzawa", true},
-                                               {Method::direct, "mumps", true}};
+  static constexpr EnumName<Method> table[] = {
+      {Method::cg, "cg"},          {Method::cr, "cr"},
+      {Method::minres, "minres"},  {Method::direct, "direct"},
+      {Method::pgs, "pgs"},        {Method::nncg, "nncg"},
+      {Method::fbgs, "fbgs"},      {Method::apgd, "apgd"},
+      {Method::cg, "uzawa", true}, {Method::direct, "mumps", true}};
 };
 inline bool is_krylov(Method m)
 {

@@ -87,11 +87,6 @@ struct StepOptions {
   // sweep_groups.hpp; where the processor has AVX2 and FMA): the same sweeps in another order,
   // at half the time a sweep (bench/README.md, "Sweeps four contacts at a time").
   bool sweep_groups = true;
-  // Method::adaptive: the sweeps hand over to the cg path (the linear pass on their active
-  // set, then sweeps) when, from probe_sweeps on, they predict that they still need more than
-  // hand_over_sweeps sweeps to the accuracy (StepSolver::slow; only with tol).
-  int probe_sweeps = 30;
-  double hand_over_sweeps = 200;
   // Whether the result reports its complementarity residual (StepResult::complementarity) and
   // counts its released and capped rows. Without, it counts nothing and measures the residual
   // only where the residual decides the solve (not under the accuracy rule with a sweeps-only
@@ -132,9 +127,6 @@ struct StepResult {
   // visit fewer; PgsResult::visits).
   double sweep_equivalents = 0;
   bool rescued = false; // the sweeps went on past opt.sweeps (StepOptions::rescue_sweeps)
-  // Method::adaptive: 1 where the sweeps were slow and handed over to the cg path (summed over
-  // substeps: Substeps::totals)
-  int preconditioned = 0;
   // The linear passes left the step worse than its warm start (complementarity residual), so
   // the sweeps started again from the warm start and their result was kept.
   bool restarted = false;

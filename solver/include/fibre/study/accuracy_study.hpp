@@ -42,7 +42,6 @@ struct StudyRow {
   double complementarity = 0;
   double error_estimate = 0; // StepResult::error_estimate
   bool converged = false;
-  int preconditioned = 0; // StepResult::preconditioned (solver adaptive handed over)
   StepAccuracy error;
 };
 
