@@ -15,8 +15,11 @@ import argparse
 import math
 import os
 import subprocess
+import sys
 
 SRC = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+sys.path.insert(0, os.path.join(SRC, "tools"))
+from lammps_runs import lmp_env, parse_dump  # noqa: E402
 
 DECK = """units si
 atom_style sphere
@@ -39,15 +42,14 @@ run 1
 
 
 def write_data(dump, path):
-    lines = open(dump).read().split("\n")
-    start = next(i for i, l in enumerate(lines) if l.startswith("ITEM: ATOMS"))
-    rows = [l.split() for l in lines[start + 1:] if l.strip()]
+    _, columns, rows = parse_dump(dump)[-1]
     out = ["pile400, settled by native LAMMPS", "", "%d atoms" % len(rows), "1 atom types",
            "0 8 xlo xhi", "0 8 ylo yhi", "0 40 zlo zhi", "", "Atoms # sphere", ""]
-    for r in rows:  # id radius mass x y z ...: the data file wants diameter and density
-        radius, mass = float(r[1]), float(r[2])
-        density = mass / (4.0 / 3.0 * math.pi * radius ** 3)
-        out.append("%s 1 %r %r %s %s %s" % (r[0], 2 * radius, density, r[3], r[4], r[5]))
+    for row in rows:  # the data file wants diameter and density
+        a = dict(zip(columns, row))
+        density = a["mass"] / (4.0 / 3.0 * math.pi * a["radius"] ** 3)
+        out.append("%d 1 %r %r %r %r %r" % (a["id"], 2 * a["radius"], density, a["x"], a["y"],
+                                            a["z"]))
     open(path, "w").write("\n".join(out) + "\n")
 
 
@@ -65,7 +67,7 @@ def main():
     deck = os.path.join(a.work, "in.takeover")
     open(deck, "w").write(DECK.format(data=data, E=a.E, mu=a.mu, keywords=a.keywords))
     subprocess.run([a.lmp, "-in", deck, "-log", "log.takeover", "-screen", "none"], cwd=a.work,
-                   check=True)
+                   env=lmp_env(), check=True)
     print("state: %s" % os.path.join(a.work, "takeover.1.0"))
 
 
