@@ -50,6 +50,7 @@ void FibreOutput::report_solve(const fibre::StepResult &res)
   stats_[V_COMPLEMENTARITY] = res.complementarity;
   stats_[V_SWEEPS] = res.sweeps;
   stats_[V_ERROR_ESTIMATE] = res.error_estimate;
+  stats_[V_RESTARTS] += res.restarts; // alike on every process
 
   double sums[3] = {double(res.fibres.num_fibres), double(res.fibres.contacts_in_fibres),
                     double(res.fibres.num_contacts)};
@@ -229,6 +230,7 @@ void FibreOutput::read_restart(const char *buf)
 {
   const double *list = reinterpret_cast<const double *>(buf);
   const int values = list[0] == kRestartFormat ? V_SIZE
+                     : list[0] == 7.0          ? V_RESTARTS
                      : list[0] == 6.0          ? V_SPLIT
                      : list[0] == 5.0          ? V_SUBSTEPS
                      : list[0] == 4.0          ? V_CHECK_VELOCITY

@@ -40,13 +40,14 @@ enum Stat {
   V_CHECK_IMPULSE,
   V_SUBSTEPS, // the last step's contact solves (its substeps; 1 where nothing moved)
   V_SPLIT,    // the last step's penetrations opened by the split recovery
+  V_RESTARTS, // solves whose slow sweeps started again (restart_sweeps), cumulative
   V_SIZE
 };
 
 class FibreOutput : protected LAMMPS_NS::Pointers {
  public:
   static constexpr int kLocalColumns = 8;
-  static constexpr double kRestartFormat = 7.0; // 7: 22 global values (6: 21, 5: 20, 4: 18, ...)
+  static constexpr double kRestartFormat = 8.0; // 8: 23 global values (7: 22, 6: 21, 5: 20, ...)
 
   explicit FibreOutput(LAMMPS_NS::LAMMPS *lmp) : Pointers(lmp)
   {

@@ -133,6 +133,49 @@ TEST(Pgs, TypedStopReasons)
   EXPECT_EQ(lambda.norm() != lambda.norm(), true); // unchanged: the caller's start
 }
 
+// The sweeps still needed, from changes that fall geometrically: log(tol / e) / log(c), e the
+// remaining error c / (1 - c) times the last change.
+TEST(Pgs, PredictsTheSweepsStillNeeded)
+{
+  PgsResult res;
+  for (int s = 0; s < kPredictSweeps; ++s) res.record(1e-2 * std::pow(0.9, s));
+  EXPECT_EQ(res.predicted_sweeps(1e-4), -1); // not enough sweeps yet
+  res.record(1e-2 * std::pow(0.9, kPredictSweeps));
+  const double e = res.last_change * 0.9 / 0.1;
+  EXPECT_NEAR(res.error_estimate(), e, 1e-12 * e);
+  EXPECT_NEAR(res.predicted_sweeps(1e-4), std::log(1e-4 / e) / std::log(0.9), 1e-9);
+  EXPECT_EQ(res.predicted_sweeps(1.0), 0); // met
+  PgsResult flat;
+  for (int s = 0; s <= kPredictSweeps; ++s) flat.record(1e-3);
+  EXPECT_EQ(flat.predicted_sweeps(1e-4), INFINITY);
+}
+
+// A solve that starts again reports both parts: its sweeps, visits and changes in order.
+TEST(Pgs, ASlowSolveStartsAgainOnce)
+{
+  Problem pr = pile(60, 0.4);
+  const Cones cones(pr.sys);
+  const std::vector<Vec6> scale = row_scales(pr.sys);
+  PgsControl control{2000, 0.0};
+  control.accuracy = 1e-12;
+  control.anderson = 3;
+  control.anderson_period = 2;
+  control.min_sweeps = 10;
+  Vector plain = Vector::Zero(pr.sys.contact_dofs());
+  const PgsResult never = pgs(pr.sys, serial_exchange(), cones, pr.b, scale, plain, control);
+  EXPECT_EQ(never.restarts, 0);
+  control.restart_sweeps = 1; // any solve not done by sweep 30 starts again
+  Vector lambda = Vector::Zero(pr.sys.contact_dofs());
+  const PgsResult res = pgs(pr.sys, serial_exchange(), cones, pr.b, scale, lambda, control);
+  ASSERT_GT(never.sweeps, 40);
+  EXPECT_EQ(res.restarts, 1);
+  EXPECT_TRUE(res.converged());
+  EXPECT_EQ(static_cast<int>(res.changes.size()), res.sweeps);
+  EXPECT_EQ(res.visits, static_cast<long long>(res.sweeps) * pr.sys.num_contacts());
+  EXPECT_EQ(res.full_sweeps.back(), res.sweeps - 1);
+  EXPECT_LT(rel_diff(lambda, plain), 1e-8); // the same solution
+}
+
 // solver pgs in the step: no linear pass, and the sweeps' accuracy in the result.
 TEST(Pgs, AsTheStepSolver)
 {

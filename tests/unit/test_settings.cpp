@@ -66,7 +66,8 @@ TEST(Settings, NoKeywordsKeepTheDefaults)
       describe(s),
       "form body, solver pgs, precond tree, weight z, tol 0.0001, linear_tol 0.0001, pass_tol "
       "0.001, maxiter 200, active_set 1, sweeps 2000, sweep_tol 0.001, rescue_sweeps 500, "
-      "min_sweeps 10, focus_sweeps 0, anderson 3, anderson_period 2, rows 6 (auto), damping 2, "
+      "min_sweeps 10, focus_sweeps 0, anderson 3, anderson_period 2, restart_sweeps 200, rows 6 "
+      "(auto), damping 2, "
       "compliance auto "
       "(0.01 dt^2 / m_min), recovery_speed auto (0.01 r_min / dt), restitution 0, "
       "bounce_speed auto (2 dt |f| / m max, or 0.01 r_min / dt without forces), coefficients "
@@ -340,7 +341,7 @@ TEST(Settings, OneTableOfKeywordsInTwoTiers)
     EXPECT_FALSE(tuning_seen && k.tier == KeywordTier::user) << k.name << " after a tuning one";
     EXPECT_FALSE(k.help.empty()) << k.name;
   }
-  EXPECT_EQ(all.size(), 38u);
+  EXPECT_EQ(all.size(), 39u);
   for (const char *bad : {"tol -1", "linear_tol 0", "anderson 99", "substep_when rest"}) {
     const std::vector<std::string> w = words(bad);
     const auto k =

@@ -512,6 +512,14 @@ std::vector<Keyword> sweep_keywords()
        },
        [](const Settings &s) { return s.step.anderson == 0; },
        "without Anderson acceleration"},
+      {{"restart_sweeps", T, quoted("restart_sweeps", "<non-negative number>"),
+        "a solve predicting more sweeps than this starts again (0: never)"},
+       [](const Reader &in, std::size_t i, const std::string &e, ParseState &st) -> std::size_t {
+         st.s.step.restart_sweeps = non_negative(in, i + 1, e);
+         return 2;
+       },
+       [](const Settings &s) { return s.step.anderson == 0 || !(s.step.accuracy > 0); },
+       "without Anderson acceleration and a tol"},
       {{"sweep_groups", T, "'sweep_groups yes|no'", "four contacts at a time (AVX2)"},
        [](const Reader &in, std::size_t i, const std::string &, ParseState &st) -> std::size_t {
          st.s.step.sweep_groups = in.yes_no(i + 1, in.at(i));

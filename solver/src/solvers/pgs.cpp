@@ -54,6 +54,37 @@ double PgsResult::impulse_estimate() const
   return last_change * contraction / (1 - contraction);
 }
 
+double PgsResult::predicted_sweeps(double accuracy) const
+{
+  const int n = static_cast<int>(full_sweeps.size());
+  if (n <= kPredictSweeps) return -1;
+  const double now = changes[full_sweeps[n - 1]],
+               then = changes[full_sweeps[n - 1 - kPredictSweeps]];
+  if (!(now > 0)) return 0;
+  const double span = full_sweeps[n - 1] - full_sweeps[n - 1 - kPredictSweeps];
+  const double rate = then > 0 ? std::pow(now / then, 1.0 / span) : 1.0;
+  if (!(rate < 1)) return INFINITY;
+  const double estimate = std::min(error_estimate(), now * rate / (1 - rate));
+  if (!(estimate > accuracy)) return 0;
+  return std::log(accuracy / estimate) / std::log(rate);
+}
+
+void PgsResult::append(const PgsResult &then)
+{
+  const int offset = static_cast<int>(changes.size());
+  const int sweeps_before = sweeps;
+  const long long visits_before = visits;
+  const int restarts_before = restarts;
+  std::vector<double> all = changes;
+  all.insert(all.end(), then.changes.begin(), then.changes.end());
+  *this = then;
+  changes = std::move(all);
+  for (int &s : full_sweeps) s += offset;
+  sweeps += sweeps_before;
+  visits += visits_before;
+  restarts += restarts_before;
+}
+
 namespace {
 
 // One sweep over the contacts `list` (in order; all of them when null, else `count`): each
@@ -260,6 +291,7 @@ class PgsRun {
   bool sweep(int s);
   bool stop_rule(bool full, const double *norms);
   bool stalled();
+  bool slow() const;
   void cg_step(int s, double change2);
 
   const ContactSystem &sys_;
@@ -511,8 +543,22 @@ bool PgsRun::sweep(int s)
     combination_ = anderson_.combined();
   }
   if (stop_rule(full, norms) || stalled()) return true;
+  if (full && slow()) {
+    res_.restarts = 1;
+    return true;
+  }
   if (control_.nonlinear_cg && s + 1 < control_.max_sweeps) cg_step(s, norms[0]);
   return false;
+}
+
+// Whether the sweeps are predicted to be slow enough to start again (PgsControl::restart_sweeps;
+// global norms: every process alike).
+bool PgsRun::slow() const
+{
+  if (!(control_.restart_sweeps > 0) || !accelerate_ || plain_ || !(control_.accuracy > 0) ||
+      res_.sweeps < control_.probe_sweeps)
+    return false;
+  return res_.predicted_sweeps(control_.accuracy) > control_.restart_sweeps;
 }
 
 // The stop rule after a sweep; true where the sweeps have converged.
@@ -592,7 +638,13 @@ void PgsRun::cg_step(int s, double change2)
 PgsResult pgs(const ContactSystem &sys, const Exchange &ex, const Cones &cones, const Vector &b,
               const std::vector<Vec6> &scale, Vector &lambda, const PgsControl &control)
 {
-  return PgsRun(sys, ex, cones, b, scale, lambda, control).run();
+  PgsResult res = PgsRun(sys, ex, cones, b, scale, lambda, control).run();
+  if (res.restarts == 0 || res.sweeps >= control.max_sweeps) return res;
+  PgsControl again = control;
+  again.max_sweeps = control.max_sweeps - res.sweeps;
+  again.restart_sweeps = 0;
+  res.append(PgsRun(sys, ex, cones, b, scale, lambda, again).run());
+  return res;
 }
 
 } // namespace fibre

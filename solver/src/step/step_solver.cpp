@@ -26,7 +26,9 @@ std::string describe(const StepOptions &opt)
          ", rescue_sweeps " + std::to_string(opt.rescue_sweeps) + ", min_sweeps " +
          std::to_string(opt.min_sweeps) + ", focus_sweeps " + std::to_string(opt.focus_sweeps) +
          ", anderson " + std::to_string(opt.anderson) +
-         (opt.anderson > 0 ? ", anderson_period " + std::to_string(opt.anderson_period) : "") +
+         (opt.anderson > 0 ? ", anderson_period " + std::to_string(opt.anderson_period) +
+                                 ", restart_sweeps " + g(opt.restart_sweeps)
+                           : "") +
          (opt.sweep_cg ? ", sweep_cg yes" : "") + (opt.sweep_blocks ? ", sweep_blocks yes" : "") +
          (opt.sweep_groups ? "" : ", sweep_groups no");
 }
@@ -307,6 +309,7 @@ void StepSolver::finish(Vector &lambda, StepResult &res) const
     control.focus_sweeps = opt_.focus_sweeps;
     control.anderson = opt_.anderson;
     control.anderson_period = opt_.anderson_period;
+    control.restart_sweeps = opt_.restart_sweeps;
     control.grouped = opt_.sweep_groups;
     control.nonlinear_cg = opt_.sweep_cg || opt_.solver == Method::nncg;
     control.fibre_blocks = opt_.sweep_blocks || opt_.solver == Method::fbgs;
@@ -322,6 +325,7 @@ void StepSolver::finish(Vector &lambda, StepResult &res) const
       res.sweeps += pr.sweeps;
       res.sweep_equivalents += nc_ > 0 ? double(pr.visits) / nc_ : 0.0;
       res.sweep_reason = pr.reason;
+      res.restarts += pr.restarts;
       res.error_estimate = pr.reported_estimate();
       res.complementarity =
           measured ? complementarity(sys_, ex_, cones_, b_full_, lambda, scale) : kNotMeasured;

@@ -36,6 +36,7 @@ StepOptions check_options(const StepOptions &step)
   ref.accuracy = kCheckAccuracy;
   ref.sweeps = kCheckSweeps;
   ref.focus_sweeps = 0;
+  ref.restart_sweeps = 0;
   ref.residual = true;
   return ref;
 }
@@ -49,6 +50,7 @@ void add_solve(StepResult &into, const StepResult &more)
   into.converged = into.converged && more.converged;
   if (into.reason == StopReason::converged) into.reason = more.reason;
   into.rescued = into.rescued || more.rescued;
+  into.restarts += more.restarts;
   into.restarted = into.restarted || more.restarted;
   into.error_estimate = std::max(into.error_estimate, more.error_estimate);
   into.complementarity = std::max(into.complementarity, more.complementarity);

@@ -59,6 +59,13 @@ struct PgsControl {
   // The groups of the sweeps kept from one solve of a system's kinematics to the next (the
   // substeps of a step) and rebuilt for other kinematics; null: built for this solve alone.
   SweepCache *cache = nullptr;
+  // A slow solve starts again once (0: never): from probe_sweeps sweeps on, with Anderson and
+  // the accuracy rule, where PgsResult::predicted_sweeps exceeds restart_sweeps, the sweeps
+  // start afresh from the last sweep's impulses (plain sweeps to min_sweeps, a new history).
+  // Anderson's combination can settle into a cycle that a fresh history leaves (a LIGGGHTS
+  // heap's step: 1,735 sweeps, restarted 193; bench/README.md, "Slow steps start again").
+  double restart_sweeps = 0;
+  int probe_sweeps = 30;
 };
 
 inline constexpr int kRateWindow = 5;
@@ -113,7 +120,16 @@ struct PgsResult {
   double met_estimate = INFINITY;
   double reported_estimate() const { return std::min(error_estimate(), met_estimate); }
   bool converged() const { return reason == StopReason::converged; }
+  // The sweeps still needed to bring the estimate to `accuracy`, from how fast the full sweeps'
+  // changes fell over their last kPredictSweeps (infinite where they did not fall; 0 where the
+  // estimate is met; -1 before there are that many).
+  double predicted_sweeps(double accuracy) const;
+  int restarts = 0; // the solve started again (PgsControl::restart_sweeps)
+  // Another solve from where this one ended: its sweeps follow this one's.
+  void append(const PgsResult &then);
 };
+
+inline constexpr int kPredictSweeps = 10; // even: Anderson mixes after every other sweep
 
 // Sweeps from lambda (feasible or not; it is projected contact by contact). `sys` must have
 // every row active; `scale` comes from row_scales(sys). In parallel each process sweeps its

@@ -83,6 +83,12 @@ struct StepOptions {
   // second sweep a solve cost 0.68 to 0.90 of a mix after every sweep, at the same or smaller
   // errors against the converged step (bench/README.md, "Anderson every other sweep").
   int anderson_period = 2;
+  // A solve of Anderson's sweeps that, from sweep 30 on, predicts more than this many sweeps
+  // still to the accuracy starts again once from its impulses (PgsControl::restart_sweeps; 0:
+  // never). On the shipped slow states it took the sweeps of a LIGGGHTS heap's step from 1,735
+  // to 193 and of a take-over's cold start from 483 to 409, and left the others within 1%
+  // (bench/README.md, "Slow steps start again").
+  double restart_sweeps = 200;
   // Full sweeps four contacts at a time, in groups that share no body (PgsControl::grouped,
   // sweep_groups.hpp; where the processor has AVX2 and FMA): the same sweeps in another order,
   // at half the time a sweep (bench/README.md, "Sweeps four contacts at a time").
@@ -127,6 +133,7 @@ struct StepResult {
   // visit fewer; PgsResult::visits).
   double sweep_equivalents = 0;
   bool rescued = false; // the sweeps went on past opt.sweeps (StepOptions::rescue_sweeps)
+  int restarts = 0;     // the sweeps started again (StepOptions::restart_sweeps)
   // The linear passes left the step worse than its warm start (complementarity residual), so
   // the sweeps started again from the warm start and their result was kept.
   bool restarted = false;
