@@ -50,7 +50,7 @@ void FibreOutput::report_solve(const fibre::StepResult &res)
   stats_[V_COMPLEMENTARITY] = res.complementarity;
   stats_[V_SWEEPS] = res.sweeps;
   stats_[V_ERROR_ESTIMATE] = res.error_estimate;
-  stats_[V_RESTARTS] += res.restarts; // alike on every process
+  stats_[V_RESTARTS] += res.slow_restarts; // alike on every process
 
   double sums[3] = {double(res.fibres.num_fibres), double(res.fibres.contacts_in_fibres),
                     double(res.fibres.num_contacts)};

@@ -163,12 +163,12 @@ TEST(Pgs, ASlowSolveStartsAgainOnce)
   control.min_sweeps = 10;
   Vector plain = Vector::Zero(pr.sys.contact_dofs());
   const PgsResult never = pgs(pr.sys, serial_exchange(), cones, pr.b, scale, plain, control);
-  EXPECT_EQ(never.restarts, 0);
+  EXPECT_EQ(never.slow_restarts, 0);
   control.restart_sweeps = 1; // any solve not done by sweep 30 starts again
   Vector lambda = Vector::Zero(pr.sys.contact_dofs());
   const PgsResult res = pgs(pr.sys, serial_exchange(), cones, pr.b, scale, lambda, control);
   ASSERT_GT(never.sweeps, 40);
-  EXPECT_EQ(res.restarts, 1);
+  EXPECT_EQ(res.slow_restarts, 1);
   EXPECT_TRUE(res.converged());
   EXPECT_EQ(static_cast<int>(res.changes.size()), res.sweeps);
   EXPECT_EQ(res.visits, static_cast<long long>(res.sweeps) * pr.sys.num_contacts());

@@ -69,20 +69,14 @@ double PgsResult::predicted_sweeps(double accuracy) const
   return std::log(accuracy / estimate) / std::log(rate);
 }
 
-void PgsResult::append(const PgsResult &then)
+void PgsResult::append(PgsResult then)
 {
-  const int offset = static_cast<int>(changes.size());
-  const int sweeps_before = sweeps;
-  const long long visits_before = visits;
-  const int restarts_before = restarts;
-  std::vector<double> all = changes;
-  all.insert(all.end(), then.changes.begin(), then.changes.end());
-  *this = then;
-  changes = std::move(all);
-  for (int &s : full_sweeps) s += offset;
-  sweeps += sweeps_before;
-  visits += visits_before;
-  restarts += restarts_before;
+  for (int &s : then.full_sweeps) s += static_cast<int>(changes.size());
+  then.changes.insert(then.changes.begin(), changes.begin(), changes.end());
+  then.sweeps += sweeps;
+  then.visits += visits;
+  then.slow_restarts += slow_restarts;
+  *this = std::move(then);
 }
 
 namespace {
@@ -544,7 +538,7 @@ bool PgsRun::sweep(int s)
   }
   if (stop_rule(full, norms) || stalled()) return true;
   if (full && slow()) {
-    res_.restarts = 1;
+    res_.slow_restarts = 1;
     return true;
   }
   if (control_.nonlinear_cg && s + 1 < control_.max_sweeps) cg_step(s, norms[0]);
@@ -639,7 +633,7 @@ PgsResult pgs(const ContactSystem &sys, const Exchange &ex, const Cones &cones, 
               const std::vector<Vec6> &scale, Vector &lambda, const PgsControl &control)
 {
   PgsResult res = PgsRun(sys, ex, cones, b, scale, lambda, control).run();
-  if (res.restarts == 0 || res.sweeps >= control.max_sweeps) return res;
+  if (res.slow_restarts == 0 || res.sweeps >= control.max_sweeps) return res;
   PgsControl again = control;
   again.max_sweeps = control.max_sweeps - res.sweeps;
   again.restart_sweeps = 0;

@@ -325,7 +325,7 @@ void StepSolver::finish(Vector &lambda, StepResult &res) const
       res.sweeps += pr.sweeps;
       res.sweep_equivalents += nc_ > 0 ? double(pr.visits) / nc_ : 0.0;
       res.sweep_reason = pr.reason;
-      res.restarts += pr.restarts;
+      res.slow_restarts += pr.slow_restarts;
       res.error_estimate = pr.reported_estimate();
       res.complementarity =
           measured ? complementarity(sys_, ex_, cones_, b_full_, lambda, scale) : kNotMeasured;

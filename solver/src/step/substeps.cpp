@@ -50,7 +50,7 @@ void add_solve(StepResult &into, const StepResult &more)
   into.converged = into.converged && more.converged;
   if (into.reason == StopReason::converged) into.reason = more.reason;
   into.rescued = into.rescued || more.rescued;
-  into.restarts += more.restarts;
+  into.slow_restarts += more.slow_restarts;
   into.restarted = into.restarted || more.restarted;
   into.error_estimate = std::max(into.error_estimate, more.error_estimate);
   into.complementarity = std::max(into.complementarity, more.complementarity);

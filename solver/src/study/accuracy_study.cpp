@@ -113,7 +113,7 @@ StudyRow measure_setting(const StepState &state, const StepOptions &opt, const V
   row.iterations = res.total_iterations;
   row.passes = res.active_set_passes;
   row.sweeps = res.sweeps;
-  row.restarts = res.restarts;
+  row.slow_restarts = res.slow_restarts;
   row.sweep_equivalents = res.sweep_equivalents;
   row.complementarity = res.complementarity;
   row.error_estimate = res.error_estimate;

@@ -124,9 +124,9 @@ struct PgsResult {
   // changes fell over their last kPredictSweeps (infinite where they did not fall; 0 where the
   // estimate is met; -1 before there are that many).
   double predicted_sweeps(double accuracy) const;
-  int restarts = 0; // the solve started again (PgsControl::restart_sweeps)
+  int slow_restarts = 0; // the solve started again (PgsControl::restart_sweeps)
   // Another solve from where this one ended: its sweeps follow this one's.
-  void append(const PgsResult &then);
+  void append(PgsResult then);
 };
 
 inline constexpr int kPredictSweeps = 10; // even: Anderson mixes after every other sweep

@@ -132,8 +132,8 @@ struct StepResult {
   // Their cost in full sweeps: contacts visited over this process's contacts (focused sweeps
   // visit fewer; PgsResult::visits).
   double sweep_equivalents = 0;
-  bool rescued = false; // the sweeps went on past opt.sweeps (StepOptions::rescue_sweeps)
-  int restarts = 0;     // the sweeps started again (StepOptions::restart_sweeps)
+  bool rescued = false;  // the sweeps went on past opt.sweeps (StepOptions::rescue_sweeps)
+  int slow_restarts = 0; // the sweeps started again (StepOptions::restart_sweeps)
   // The linear passes left the step worse than its warm start (complementarity residual), so
   // the sweeps started again from the warm start and their result was kept.
   bool restarted = false;

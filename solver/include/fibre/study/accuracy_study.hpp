@@ -38,7 +38,7 @@ struct StudyRow {
   double seconds = 0;    // the fastest of the repeats
   double k_products = 0; // seconds / k_product_seconds
   int iterations = 0, passes = 0, sweeps = 0;
-  int restarts = 0;             // StepResult::restarts
+  int slow_restarts = 0;        // StepResult::slow_restarts
   double sweep_equivalents = 0; // StepResult::sweep_equivalents
   double complementarity = 0;
   double error_estimate = 0; // StepResult::error_estimate
