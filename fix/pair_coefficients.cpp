@@ -84,6 +84,7 @@ void set_granular(const int *model, const double *normal, const double *tangenti
                  : model[2] == 1 ? fibre::TangentialLaw::linear
                                  : fibre::TangentialLaw::mindlin;
   p.k_t = tangential[0];
+  p.tangential_damping = tangential[1]; // x_gamma_t: its dashpot over the normal one
   p.k_roll = model[3] == 1 ? roll[0] : 0.0;
   p.k_twist = model[4] == 1 ? twist[0] : 0.0;
   p.gamma_roll = model[3] == 1 ? roll[1] : 0.0;
@@ -153,9 +154,8 @@ void read_granular(const std::string &bytes, int ntypes, PairReading &out)
                       "'compliance auto' makes the rows rigid), and the normal, rolling and "
                       "twisting dampers their rows' damping, at least SPOOK's (with "
                       "'normal_relaxation law' the normal row is the law's spring and dashpot "
-                      "by implicit Euler; the tangential rows take the normal law's or its "
-                      "critical damping, whichever is longer; bounces take e); the tangential "
-                      "damping coefficient is not used");
+                      "by implicit Euler; the tangential rows take the law's tangential "
+                      "dashpot, x_gamma_t times the normal one; bounces take e)");
   out.table = std::move(table);
   out.material = true;
 }
@@ -167,7 +167,7 @@ void read_gran(const std::string &style, const std::string &bytes, int ntypes, P
   const bool hertz = style == "gran/hertz/history", history = style != "gran/hooke";
   Record rec(bytes);
   const double kn = rec.next_double(), kt = rec.next_double(), gamman = rec.next_double();
-  rec.next_double(); // gammat
+  const double gammat = rec.next_double(); // NULL and dampflag 0 are resolved in it
   const double xmu = rec.next_double();
   rec.next_int(); // dampflag
   for (int k = 0; k < ntypes * (ntypes + 1) / 2; ++k) rec.next_int();
@@ -193,6 +193,7 @@ void read_gran(const std::string &style, const std::string &bytes, int ntypes, P
         p.viscous =
             hertz ? fibre::ViscousDamping::viscoelastic : fibre::ViscousDamping::mass_velocity;
         p.viscous_coeff = gamman;
+        p.tangential_damping = gammat / gamman;
       }
     }
   out.notes.push_back("pair style " + style + ": mu = xmu " + fibre::format_g(xmu) + "; kn " +
@@ -242,6 +243,9 @@ void read_wall_gran(const std::vector<std::string> &words, WallReading &out)
   p.viscous = hertz ? fibre::ViscousDamping::viscoelastic : fibre::ViscousDamping::mass_velocity;
   p.viscous_coeff = v[2];
   p.mu = v[4];
+  // fix wall/gran's gamma_t (NULL: gamma_n / 2), none with dampflag 0
+  const double gammat = words[4] == "NULL" ? 0.5 * v[2] : v[3];
+  if (v[2] > 0) p.tangential_damping = v[5] == 0 ? 0.0 : gammat / v[2];
 }
 
 // One model of fix wall/gran granular at words[k] (hooke, hertz, hertz/material, dmt, jkr,
@@ -299,6 +303,7 @@ std::size_t read_granular_model(const std::vector<std::string> &words, std::size
     p.tangential =
         next == "linear_history" ? fibre::TangentialLaw::linear : fibre::TangentialLaw::mindlin;
     p.k_t = null ? e_mod / 4.0 * (2.0 - nu) * (1.0 + nu) : v[0]; // fix wall/gran's constant
+    p.tangential_damping = v[1];                                 // x_gamma_t
     p.mu = v[2];
     return 5;
   }

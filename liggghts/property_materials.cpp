@@ -70,19 +70,22 @@ bool matches(LAMMPS_NS::PairGran *pair, const char *kind, const char *model)
 
 // LIGGGHTS's hooke for type pair (i, j): Y_eff and the characteristicVelocity give each
 // contact its k_n and k_t = k_n (fibre::contact_law); the dashpot sqrt(4 m_eff k_n / (1 + (pi /
-// ln e)^2)) is alpha sqrt(m_eff k_n) with alpha = 2 |ln e| / sqrt(ln^2 e + pi^2).
+// ln e)^2)) is alpha sqrt(m_eff k_n) with alpha = 2 |ln e| / sqrt(ln^2 e + pi^2). Its
+// tangential dashpot (tangential_damping on, the default) is the normal one.
 void set_hooke(double y_eff, double v_char, bool history, fibre::PairCoefficients &p)
 {
   p.normal = fibre::NormalLaw::hooke;
   p.hooke_y_eff = y_eff;
   p.hooke_velocity = v_char;
   if (history) p.tangential = fibre::TangentialLaw::linear;
+  p.tangential_damping = 1.0;
   const double e = p.restitution;
   if (e > 0 && e <= 1) p.damping_alpha = fibre::liggghts_hooke_damping(e);
 }
 
 // LIGGGHTS's hertz with tangential history: k_n = 4/3 Y_eff, Mindlin's k_t = 8 G_eff, and its
-// normal dashpot for the pair's restitution.
+// normal dashpot for the pair's restitution. Its tangential dashpot (tangential_damping on, the
+// default) is the normal one times sqrt(S_t / S_n), S_t = 8 G_eff a and S_n = 2 Y_eff a.
 void set_hertz(double y_eff, double g_eff, bool history, fibre::PairCoefficients &p)
 {
   p.normal = fibre::NormalLaw::hertz_material;
@@ -91,6 +94,7 @@ void set_hertz(double y_eff, double g_eff, bool history, fibre::PairCoefficients
     p.tangential = fibre::TangentialLaw::mindlin;
     p.k_t = 8.0 * g_eff;
   }
+  if (y_eff > 0) p.tangential_damping = 2.0 * std::sqrt(g_eff / y_eff);
   const double e = p.restitution;
   if (e > 0 && e <= 1) p.damping_alpha = fibre::liggghts_hertz_damping(e);
 }
@@ -169,6 +173,10 @@ PairReading read_pair_coefficients(LAMMPS_NS::LAMMPS *lmp)
   if (!restitution)
     out.notes.push_back("no coefficientRestitution: contacts are plastic unless the fix's "
                         "restitution keyword is given");
+  if (hertz || hooke)
+    out.notes.push_back("the tangential springs take the model's tangential dashpot as "
+                        "'tangential_damping on' (its default) gives it; 'tangential_damping "
+                        "off' is not read");
 
   fibre::MaterialTable table(ntypes);
   for (int i = 1; i <= ntypes; ++i)

@@ -4,6 +4,7 @@
 // obstacles and typed keywords.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <tuple>
 
@@ -612,6 +613,60 @@ TEST(Material, LoadedContactsTakeTheLawsDashpot)
       EXPECT_NEAR(c.spring_damping[1], critical, 1e-9 * critical);
       EXPECT_EQ(c.spring_damping[2], c.spring_damping[1]);
     }
+}
+
+// A law's own tangential dashpot, x gamma_n (LAMMPS's x_gamma_t, gran/*'s gamma_t / gamma_n), is
+// its springs' damping time x gamma_n / k_t, at least SPOOK's d and the normal row's critical
+// damping up to 5 steps: an undamped spring (x = 0) at a step far below the collision time takes
+// 5 steps, where without the law's dashpot it took the whole critical damping.
+TEST(Material, TangentialSpringsTakeTheLawsDashpot)
+{
+  std::vector<Body> bodies(1);
+  bodies[0].type = 1;
+  bodies[0].mass = 0.2;
+  bodies[0].radius = 0.25;
+  std::vector<Contact> contacts(1);
+  contacts[0].a = 0; // a wall contact, loaded
+  contacts[0].gap = -1e-3;
+  ContactModel model;
+  model.compliance.automatic = false;
+  model.compliance.material = true;
+  model.rows = 3;
+  model.materials = MaterialTable(1);
+  PairCoefficients p = hertz_material_pair();
+  p.tangential = TangentialLaw::mindlin;
+  p.k_t = 6e4;
+  p.damping_alpha = tsuji_damping(0.3);
+  const double r = 0.25, d = 1e-3, a = std::sqrt(r * d), k_n = p.k_n * a, k_t = p.k_t * a;
+  const double gamma_n = p.damping_alpha * std::sqrt(0.2 * k_n);
+  Vector last = Vector::Constant(3, 0.0);
+  for (const double x : {0.0, 0.5, 1.0, 4.0})
+    for (const double h : {1e-5, 1e-4, 1e-2}) {
+      p.tangential_damping = x;
+      model.materials.at(1, 1) = p;
+      last[0] = k_n * d * h;
+      apply_contact_model(model, step_of(h), 1.0, bodies, contacts, &last);
+      const Contact &c = contacts[0];
+      ASSERT_TRUE(c.elastic[1] && c.elastic[2]);
+      EXPECT_NEAR(1.0 / c.compliance[1], k_t, 1e-9 * k_t);
+      EXPECT_DOUBLE_EQ(tangential_damper_time(p, gamma_n, 1.0 / k_t), x * gamma_n / k_t);
+      const double critical = 2.0 * std::sqrt(0.2 / k_n) / h;
+      const double expected =
+          std::max({model.damping, x * gamma_n / k_t / h, std::min(critical, 5.0)});
+      EXPECT_NEAR(c.spring_damping[1], expected, 1e-9 * expected) << x << " " << h;
+      EXPECT_EQ(c.spring_damping[2], c.spring_damping[1]);
+      if (x == 0.0 && h == 1e-5) { // 5 steps, not the normal row's critical damping
+        EXPECT_EQ(c.spring_damping[1], 5.0);
+        EXPECT_GT(critical, 10.0 * model.damping);
+      }
+      if (x == 4.0 && h == 1e-5) { // the law's dashpot where it is the longer
+        EXPECT_NEAR(c.spring_damping[1], 4.0 * gamma_n / k_t / h, 1e-9 * c.spring_damping[1]);
+        EXPECT_GT(c.spring_damping[1], 5.0);
+      }
+    }
+  EXPECT_LT(tangential_damper_time(p, -1.0, 1.0), 0.0); // no normal dashpot
+  p.tangential_damping = -1.0;
+  EXPECT_LT(tangential_damper_time(p, gamma_n, 1.0), 0.0);
 }
 
 // The collision time of the elastic laws against the collision integrated by RK4 (m d'' = -F(d)

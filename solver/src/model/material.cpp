@@ -72,6 +72,9 @@ std::string MaterialTable::mix()
       p.k_twist = geom(a.k_twist, b.k_twist);
       p.gamma_roll = geom(a.gamma_roll, b.gamma_roll);
       p.gamma_twist = geom(a.gamma_twist, b.gamma_twist);
+      p.tangential_damping = a.tangential_damping >= 0 && b.tangential_damping >= 0
+                                 ? geom(a.tangential_damping, b.tangential_damping)
+                                 : -1.0;
       if (a.viscous != b.viscous)
         return "types " + pair + ": different normal damping models cannot mix";
       p.viscous = a.viscous;
@@ -338,6 +341,12 @@ double normal_damper(const PairCoefficients &p, double m_eff, double a, double k
     break;
   }
   return -1.0;
+}
+
+double tangential_damper_time(const PairCoefficients &p, double gamma_n, double eps_t)
+{
+  if (!(p.tangential_damping >= 0 && gamma_n >= 0)) return -1.0;
+  return p.tangential_damping * gamma_n * eps_t;
 }
 
 double spring_damping_time(const PairCoefficients &p, int r)

@@ -60,6 +60,10 @@ struct PairCoefficients {
   // element of damping time gamma / k (spring_damping_time).
   double gamma_roll = 0.0;
   double gamma_twist = 0.0;
+  // The tangential dashpot as a multiple of the normal one (LAMMPS granular's x_gamma_t,
+  // gran/*'s gamma_t / gamma_n: 0 with dampflag 0); < 0: not known, the tangential rows take
+  // the normal row's damping (tangential_damper_time).
+  double tangential_damping = -1.0;
   // LIGGGHTS's hooke: the stiffnesses of each contact follow from its effective Young's
   // modulus and the deck's characteristicVelocity v_c (> 0), k_n = 16/15 sqrt(r_eff) Y_eff (15
   // m_eff v_c^2 / (16 sqrt(r_eff) Y_eff))^(1/5) and k_t = k_n (contact_law); k_n and k_t are
@@ -178,6 +182,9 @@ PairCollisionTime shortest_collision_time(const MaterialTable &table, double r, 
 // it: tsuji alpha sqrt(m_eff k), velocity c, mass_velocity c m_eff, viscoelastic c m_eff a.
 // < 0 where the pair has no damping law.
 double normal_damper(const PairCoefficients &p, double m_eff, double a, double k);
+// The damping time b_t / k_t of the tangential spring k_t = 1 / eps_t, its dashpot b_t the
+// law's tangential_damping times the normal dashpot gamma_n (>= 0); < 0 where either is unknown.
+double tangential_damper_time(const PairCoefficients &p, double gamma_n, double eps_t);
 
 // The damping time (seconds) of row r's spring in the pair's law, gamma / k of the SDS rolling
 // (rows 4, 5) and twisting (row 3) laws; 0 where the law has no damper of its own.
