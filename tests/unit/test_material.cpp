@@ -561,6 +561,30 @@ TEST(Material, NormalDampersOfTheDampingModels)
   EXPECT_NE(t.mix(), "");
 }
 
+// A sphere of mass 0.2 and radius 0.25 pressed 1e-3 into a wall, under compliance material with
+// a Mindlin, Tsuji-damped Hertz law (p, not yet in the model's table).
+struct LoadedWallContact {
+  std::vector<Body> bodies = std::vector<Body>(1);
+  std::vector<Contact> contacts = std::vector<Contact>(1);
+  ContactModel model;
+  PairCoefficients p = hertz_material_pair();
+  LoadedWallContact()
+  {
+    bodies[0].type = 1;
+    bodies[0].mass = 0.2;
+    bodies[0].radius = 0.25;
+    contacts[0].a = 0;
+    contacts[0].gap = -1e-3;
+    model.compliance.automatic = false;
+    model.compliance.material = true;
+    model.rows = 3;
+    model.materials = MaterialTable(1);
+    p.tangential = TangentialLaw::mindlin;
+    p.k_t = 6e4;
+    p.damping_alpha = tsuji_damping(0.3);
+  }
+};
+
 // A loaded contact's normal row takes the law's dashpot as its damping time (gamma_n / k_n)
 // where that is longer than SPOOK's d steps; where the step is too large for it, the law's
 // spring and dashpot by implicit Euler (normal_relaxation law, SPOOK's row at 3/4 + tau / h
@@ -568,22 +592,11 @@ TEST(Material, NormalDampersOfTheDampingModels)
 // damping.
 TEST(Material, LoadedContactsTakeTheLawsDashpot)
 {
-  std::vector<Body> bodies(1);
-  bodies[0].type = 1;
-  bodies[0].mass = 0.2;
-  bodies[0].radius = 0.25;
-  std::vector<Contact> contacts(1);
-  contacts[0].a = 0; // a wall contact, loaded
-  contacts[0].gap = -1e-3;
-  ContactModel model;
-  model.compliance.automatic = false;
-  model.compliance.material = true;
-  model.rows = 3;
-  model.materials = MaterialTable(1);
-  PairCoefficients p = hertz_material_pair();
-  p.tangential = TangentialLaw::mindlin;
-  p.k_t = 6e4;
-  p.damping_alpha = tsuji_damping(0.3);
+  LoadedWallContact w;
+  std::vector<Body> &bodies = w.bodies;
+  std::vector<Contact> &contacts = w.contacts;
+  ContactModel &model = w.model;
+  PairCoefficients &p = w.p;
   model.materials.at(1, 1) = p;
   const double r = 0.25, d = 1e-3, k_n = p.k_n * std::sqrt(r * d);
   const double gamma_n = p.damping_alpha * std::sqrt(0.2 * k_n);
@@ -621,22 +634,11 @@ TEST(Material, LoadedContactsTakeTheLawsDashpot)
 // 5 steps, where without the law's dashpot it took the whole critical damping.
 TEST(Material, TangentialSpringsTakeTheLawsDashpot)
 {
-  std::vector<Body> bodies(1);
-  bodies[0].type = 1;
-  bodies[0].mass = 0.2;
-  bodies[0].radius = 0.25;
-  std::vector<Contact> contacts(1);
-  contacts[0].a = 0; // a wall contact, loaded
-  contacts[0].gap = -1e-3;
-  ContactModel model;
-  model.compliance.automatic = false;
-  model.compliance.material = true;
-  model.rows = 3;
-  model.materials = MaterialTable(1);
-  PairCoefficients p = hertz_material_pair();
-  p.tangential = TangentialLaw::mindlin;
-  p.k_t = 6e4;
-  p.damping_alpha = tsuji_damping(0.3);
+  LoadedWallContact w;
+  std::vector<Body> &bodies = w.bodies;
+  std::vector<Contact> &contacts = w.contacts;
+  ContactModel &model = w.model;
+  PairCoefficients &p = w.p;
   const double r = 0.25, d = 1e-3, a = std::sqrt(r * d), k_n = p.k_n * a, k_t = p.k_t * a;
   const double gamma_n = p.damping_alpha * std::sqrt(0.2 * k_n);
   Vector last = Vector::Constant(3, 0.0);
