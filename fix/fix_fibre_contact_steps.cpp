@@ -64,10 +64,11 @@ bool FixFibreContact::note_moving_walls(const std::vector<fibre::Contact> &conta
 // a moving wall, takes substeps of at most kEveryMovingCollisions t_c (note_moving_walls).
 int FixFibreContact::step_substeps()
 {
-  const fibre::ContactModel &model = settings_.model;
   fibre::PairCollisionTime shortest{};
-  if (model.compliance.material && m_min_ > 0 && r_min_ > 0)
-    shortest = fibre::shortest_collision_time(model.materials, r_min_, m_min_, 1.0);
+  if (settings_.model.compliance.material && m_min_ > 0 && r_min_ > 0)
+    shortest = fibre::shortest_collision_time(settings_.model.materials, r_min_, m_min_, 1.0);
+  settings_.model.collision_time = shortest.t_c;
+  const fibre::ContactModel &model = settings_.model;
   const bool moving = moving_walls_met_ && h_ > dtv_;
   const double cap = moving ? fibre::kEveryMovingCollisions : INFINITY;
   const int n = fibre::substeps_for(model, h_, shortest.t_c, cap);

@@ -629,46 +629,55 @@ TEST(Material, LoadedContactsTakeTheLawsDashpot)
 }
 
 // A law's own tangential dashpot, x gamma_n (LAMMPS's x_gamma_t, gran/*'s gamma_t / gamma_n), is
-// its springs' damping time x gamma_n / k_t, at least SPOOK's d and the normal row's critical
-// damping up to 5 steps: an undamped spring (x = 0) at a step far below the collision time takes
-// 5 steps, where without the law's dashpot it took the whole critical damping.
+// its springs' damping time x gamma_n / k_t at a step of at most 0.1 collision times, at least
+// SPOOK's d and the normal row's critical damping up to 5 steps: an undamped spring (x = 0) far
+// below the collision time takes 5 steps, not the whole critical damping. At longer steps, or
+// with the collision time unknown, the springs are damped as without the law's dashpot.
 TEST(Material, TangentialSpringsTakeTheLawsDashpot)
 {
   LoadedWallContact w;
-  std::vector<Body> &bodies = w.bodies;
-  std::vector<Contact> &contacts = w.contacts;
-  ContactModel &model = w.model;
-  PairCoefficients &p = w.p;
-  const double r = 0.25, d = 1e-3, a = std::sqrt(r * d), k_n = p.k_n * a, k_t = p.k_t * a;
-  const double gamma_n = p.damping_alpha * std::sqrt(0.2 * k_n);
+  const double r = 0.25, d = 1e-3, a = std::sqrt(r * d), k_n = w.p.k_n * a, k_t = w.p.k_t * a;
+  const double gamma_n = w.p.damping_alpha * std::sqrt(0.2 * k_n);
+  const double t_c = 1e-3; // the law's collision time, as the front end sets it
   Vector last = Vector::Constant(3, 0.0);
-  for (const double x : {0.0, 0.5, 1.0, 4.0})
-    for (const double h : {1e-5, 1e-4, 1e-2}) {
-      p.tangential_damping = x;
-      model.materials.at(1, 1) = p;
-      last[0] = k_n * d * h;
-      apply_contact_model(model, step_of(h), 1.0, bodies, contacts, &last);
-      const Contact &c = contacts[0];
-      ASSERT_TRUE(c.elastic[1] && c.elastic[2]);
-      EXPECT_NEAR(1.0 / c.compliance[1], k_t, 1e-9 * k_t);
-      EXPECT_DOUBLE_EQ(tangential_damper_time(p, gamma_n, 1.0 / k_t), x * gamma_n / k_t);
+  // spring_damping[1] for tangential damping x and collision time t
+  const auto damping = [&](double x, double h, double t) {
+    w.p.tangential_damping = x;
+    w.model.materials.at(1, 1) = w.p;
+    w.model.collision_time = t;
+    last[0] = k_n * d * h;
+    apply_contact_model(w.model, step_of(h), 1.0, w.bodies, w.contacts, &last);
+    const Contact &c = w.contacts[0];
+    EXPECT_TRUE(c.elastic[1] && c.elastic[2]);
+    EXPECT_NEAR(1.0 / c.compliance[1], k_t, 1e-9 * k_t);
+    EXPECT_EQ(c.spring_damping[2], c.spring_damping[1]);
+    return c.spring_damping[1];
+  };
+  for (const double x : {0.0, 0.5, 1.0, 4.0}) {
+    w.p.tangential_damping = x;
+    EXPECT_DOUBLE_EQ(tangential_damper_time(w.p, gamma_n, 1.0 / k_t), x * gamma_n / k_t);
+    for (const double h : {1e-5, 1e-4}) {
       const double critical = 2.0 * std::sqrt(0.2 / k_n) / h;
       const double expected =
-          std::max({model.damping, x * gamma_n / k_t / h, std::min(critical, 5.0)});
-      EXPECT_NEAR(c.spring_damping[1], expected, 1e-9 * expected) << x << " " << h;
-      EXPECT_EQ(c.spring_damping[2], c.spring_damping[1]);
-      if (x == 0.0 && h == 1e-5) { // 5 steps, not the normal row's critical damping
-        EXPECT_EQ(c.spring_damping[1], 5.0);
-        EXPECT_GT(critical, 10.0 * model.damping);
-      }
-      if (x == 4.0 && h == 1e-5) { // the law's dashpot where it is the longer
-        EXPECT_NEAR(c.spring_damping[1], 4.0 * gamma_n / k_t / h, 1e-9 * c.spring_damping[1]);
-        EXPECT_GT(c.spring_damping[1], 5.0);
-      }
+          std::max({w.model.damping, x * gamma_n / k_t / h, std::min(critical, 5.0)});
+      EXPECT_NEAR(damping(x, h, t_c), expected, 1e-9 * expected) << x << " " << h;
+      EXPECT_EQ(damping(x, h, 0.0), damping(-1.0, h, t_c)) << x << " " << h; // unknown t_c
     }
-  EXPECT_LT(tangential_damper_time(p, -1.0, 1.0), 0.0); // no normal dashpot
-  p.tangential_damping = -1.0;
-  EXPECT_LT(tangential_damper_time(p, gamma_n, 1.0), 0.0);
+    EXPECT_EQ(damping(x, 1e-2, t_c), damping(-1.0, 1e-2, t_c)) << x; // 10 t_c a step
+    EXPECT_EQ(damping(x, 2e-4, t_c), damping(-1.0, 2e-4, t_c)) << x; // 0.2 t_c a step
+  }
+  // far below t_c: 5 steps, not the normal row's critical damping, which it took before
+  const double critical = 2.0 * std::sqrt(0.2 / k_n) / 1e-5;
+  EXPECT_EQ(damping(0.0, 1e-5, t_c), 5.0);
+  EXPECT_NEAR(damping(-1.0, 1e-5, t_c), critical, 1e-9 * critical);
+  EXPECT_GT(critical, 10.0 * w.model.damping);
+  // the law's dashpot where it is the longer
+  const double law = 4.0 * gamma_n / k_t / 1e-5;
+  EXPECT_NEAR(damping(4.0, 1e-5, t_c), law, 1e-9 * law);
+  EXPECT_GT(law, 5.0);
+  EXPECT_LT(tangential_damper_time(w.p, -1.0, 1.0), 0.0); // no normal dashpot
+  w.p.tangential_damping = -1.0;
+  EXPECT_LT(tangential_damper_time(w.p, gamma_n, 1.0), 0.0);
 }
 
 // The collision time of the elastic laws against the collision integrated by RK4 (m d'' = -F(d)
