@@ -154,8 +154,9 @@ void read_granular(const std::string &bytes, int ntypes, PairReading &out)
                       "'compliance auto' makes the rows rigid), and the normal, rolling and "
                       "twisting dampers their rows' damping, at least SPOOK's (with "
                       "'normal_relaxation law' the normal row is the law's spring and dashpot "
-                      "by implicit Euler; the tangential rows take the law's tangential "
-                      "dashpot, x_gamma_t times the normal one; bounces take e)");
+                      "by implicit Euler; at steps of at most 0.1 collision times the "
+                      "tangential rows take the law's tangential dashpot, x_gamma_t times the "
+                      "normal one; bounces take e)");
   out.table = std::move(table);
   out.material = true;
 }

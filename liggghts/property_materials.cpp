@@ -174,9 +174,9 @@ PairReading read_pair_coefficients(LAMMPS_NS::LAMMPS *lmp)
     out.notes.push_back("no coefficientRestitution: contacts are plastic unless the fix's "
                         "restitution keyword is given");
   if (hertz || hooke)
-    out.notes.push_back("the tangential springs take the model's tangential dashpot as "
-                        "'tangential_damping on' (its default) gives it; 'tangential_damping "
-                        "off' is not read");
+    out.notes.push_back("at steps of at most 0.1 collision times the tangential springs take "
+                        "the model's tangential dashpot as 'tangential_damping on' (its default) "
+                        "gives it; 'tangential_damping off' is not read");
 
   fibre::MaterialTable table(ntypes);
   for (int i = 1; i <= ntypes; ++i)
