@@ -68,6 +68,7 @@ int FixFibreContact::step_substeps()
   if (settings_.model.compliance.material && m_min_ > 0 && r_min_ > 0)
     shortest = fibre::shortest_collision_time(settings_.model.materials, r_min_, m_min_, 1.0);
   settings_.model.collision_time = shortest.t_c;
+  settings_.model.solve_step = h_;
   const fibre::ContactModel &model = settings_.model;
   const bool moving = moving_walls_met_ && h_ > dtv_;
   const double cap = moving ? fibre::kEveryMovingCollisions : INFINITY;
