@@ -242,7 +242,8 @@ void apply_pair(const ContactModel &model, const PairCoefficients &pc, const Spo
   // critical damping: below it a pile at rest rocks on its rolling springs, and a sphere that
   // a bowl's rolling resistance stops rolls back up. The SDS springs carry the law's own damper
   // (SPOOK's damping time is the Kelvin-Voigt element's gamma / k) where that is longer. The
-  // tangential springs take the law's dashpot, or that floor where the law has none.
+  // tangential springs keep that floor too, but where a solve's step resolves the collisions
+  // and the law has a tangential dashpot (below).
   const double contact_d = std::max(model.damping, c.damping);
   const double floor = std::max(contact_d, critical);
   const bool resolved = model.collision_time > 0 &&
