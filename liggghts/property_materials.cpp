@@ -79,6 +79,7 @@ void set_hooke(double y_eff, double v_char, bool history, fibre::PairCoefficient
   p.hooke_velocity = v_char;
   if (history) p.tangential = fibre::TangentialLaw::linear;
   p.tangential_damping = 1.0;
+  p.cone_on_spring = true;
   const double e = p.restitution;
   if (e > 0 && e <= 1) p.damping_alpha = fibre::liggghts_hooke_damping(e);
 }
@@ -95,6 +96,7 @@ void set_hertz(double y_eff, double g_eff, bool history, fibre::PairCoefficients
     p.k_t = 8.0 * g_eff;
   }
   if (y_eff > 0) p.tangential_damping = 2.0 * std::sqrt(g_eff / y_eff);
+  p.cone_on_spring = true;
   const double e = p.restitution;
   if (e > 0 && e <= 1) p.damping_alpha = fibre::liggghts_hertz_damping(e);
 }

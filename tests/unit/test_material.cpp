@@ -680,6 +680,191 @@ TEST(Material, TangentialSpringsTakeTheLawsDashpot)
   EXPECT_LT(tangential_damper_time(w.p, gamma_n, 1.0), 0.0);
 }
 
+namespace {
+
+// An impact's slip, integrated directly in the deck's units (RK4, 2e5 steps over the contact):
+// m d'' = -F_n, F_n = K d^p + g d^q d', and m_t u'' = F_t = -k_t d^s S - x g d^q u, S' = u, from
+// d = S = 0 at approach v and slip u0, the spring set back to |F_t| = mu |F_n| at each step's
+// start where it is beyond it; returns -u / u0 when d closes. With spring_cone, LIGGGHTS's
+// rule: the cone bounds k_t S alone, and the sliding spring takes no dashpot. The reference for
+// tangential_restitution.
+double direct_slip_rebound(double m, double K, double p, double g, double q, double v, double m_t,
+                           double k_t, double s, double x, double mu = INFINITY, double u0 = 1.0,
+                           bool spring_cone = false)
+{
+  using State = std::array<double, 4>;
+  const auto forces = [&](const State &z, double &spring, double &f_n) {
+    const double d = std::max(z[0], 0.0), damper = g * std::pow(d, q);
+    f_n = K * std::pow(d, p) + damper * z[1];
+    const double k = k_t * std::pow(d, s), f_t = -k * spring - x * damper * z[3];
+    if (spring_cone) {
+      if (std::isinf(mu) || std::abs(k * spring) <= mu * std::abs(f_n)) return f_t;
+      if (k > 0) spring = std::copysign(mu * std::abs(f_n) / k, spring);
+      return -std::copysign(mu * std::abs(f_n), spring);
+    }
+    if (std::isinf(mu) || std::abs(f_t) <= mu * std::abs(f_n)) return f_t;
+    const double cone = std::copysign(mu * std::abs(f_n), f_t);
+    if (k > 0) spring = -(cone + x * damper * z[3]) / k;
+    return cone;
+  };
+  const auto rate = [&](const State &z) {
+    double spring = z[2], f_n = 0.0;
+    const double f_t = forces(z, spring, f_n);
+    return State{z[1], -f_n / m, z[3], f_t / m_t};
+  };
+  const double dt = std::pow(m * v * v / K, 1.0 / (p + 1.0)) / v / 20000.0;
+  State z{0.0, v, 0.0, u0};
+  for (int k = 0; k < 2000000; ++k) {
+    double f_n = 0.0;
+    forces(z, z[2], f_n);
+    State k1 = rate(z), m1, k2, k3, k4, next;
+    for (int i = 0; i < 4; ++i) m1[i] = z[i] + 0.5 * dt * k1[i];
+    k2 = rate(m1);
+    for (int i = 0; i < 4; ++i) m1[i] = z[i] + 0.5 * dt * k2[i];
+    k3 = rate(m1);
+    for (int i = 0; i < 4; ++i) m1[i] = z[i] + dt * k3[i];
+    k4 = rate(m1);
+    for (int i = 0; i < 4; ++i) next[i] = z[i] + dt / 6.0 * (k1[i] + 2 * k2[i] + 2 * k3[i] + k4[i]);
+    if (k > 0 && next[0] <= 0.0) return -(z[3] + z[0] / (z[0] - next[0]) * (next[3] - z[3])) / u0;
+    z = next;
+  }
+  return NAN;
+}
+
+} // namespace
+
+// The tangential restitution of an impact that sticks. Hooke's law with an undamped linear
+// spring: the slip oscillates at sqrt(k_t / m_t) for pi sqrt(m_eff / k_n), e_t = -cos(pi
+// sqrt(k_t m_eff / (k_n m_t))): 1 (reversed) where the two frequencies are equal, -0.918 with
+// LIGGGHTS's hooke (k_t = k_n, m_t = 2/7 m_eff). A dashpot that makes the slip's equation the
+// normal one's gives e_t = e_n = exp(-c pi / (2 omega_d)). Hertz-Mindlin with Tsuji's dashpot
+// and gran/hertz/history's mass_velocity against a direct integration in the deck's units.
+TEST(Material, TangentialReboundOfTheLaw)
+{
+  PairCoefficients p;
+  p.normal = NormalLaw::hooke;
+  p.tangential = TangentialLaw::linear;
+  p.k_n = 2000.0;
+  p.tangential_damping = 0.0;
+  const double m = 0.5, m_t = 2.0 / 7.0 * m;
+  p.k_t = 2.0 / 7.0 * p.k_n;
+  for (double v : {0.1, 3.0})
+    EXPECT_NEAR(tangential_restitution(p, m, m_t, 0.25, v, 0.0), 1.0, 1e-4);
+  p.k_t = p.k_n;
+  const double liggghts = -std::cos(M_PI * std::sqrt(3.5));
+  EXPECT_NEAR(tangential_restitution(p, m, m_t, 0.25, 1.0, 0.0), liggghts, 1e-4);
+  // m x'' + c m x' + k x = 0, and the slip's m_t u'' + (m_t / m) c m u' + k_t u = 0 alike
+  p.viscous = ViscousDamping::mass_velocity;
+  p.viscous_coeff = 50.0;
+  p.k_t = 2.0 / 7.0 * p.k_n;
+  p.tangential_damping = m_t / m;
+  const double omega_d = std::sqrt(p.k_n / m - 0.25 * 50.0 * 50.0);
+  const double e_n = std::exp(-50.0 * M_PI / (2.0 * omega_d));
+  EXPECT_NEAR(viscous_restitution(p, m, 0.25, 1.0), e_n, 2e-3);
+  for (double v : {0.1, 3.0})
+    EXPECT_NEAR(tangential_restitution(p, m, m_t, 0.25, v, 0.0), e_n, 2e-3);
+  p.tangential_damping = 0.5; // gran/hooke/history's gammat NULL
+  EXPECT_NEAR(tangential_restitution(p, m, m_t, 0.25, 1.0, 0.0),
+              direct_slip_rebound(m, p.k_n, 1, 50.0 * m, 0, 1.0, m_t, p.k_t, 0, 0.5), 2e-3);
+  // Hooke with Mindlin's spring k_t a: the slip's stiffness grows with the impact's speed
+  p.tangential = TangentialLaw::mindlin;
+  p.k_t = 2.0e4;
+  for (double v : {0.1, 0.7, 3.0})
+    EXPECT_NEAR(tangential_restitution(p, m, m_t, 0.25, v, 0.0),
+                direct_slip_rebound(m, p.k_n, 1, 50.0 * m, 0, v, m_t, p.k_t * 0.5, 0.5, 0.5), 1e-2)
+        << "v " << v;
+  // Hertz-Mindlin, Tsuji (the oblique impact's E 1e8 law) and viscous mass_velocity
+  PairCoefficients h = hertz_material_pair();
+  const double nu = 0.2857142857; // against a like wall: E_eff E / (2 (1 - nu^2))
+  h.k_n = 4.0 / 3.0 * 1e8 / (2.0 * (1.0 - nu * nu));
+  h.tangential = TangentialLaw::mindlin;
+  h.k_t = 8.0 * 1e8 / (4.0 * (2.0 - nu) * (1.0 + nu));
+  h.damping_alpha = tsuji_damping(0.1);
+  const double r = 0.4, mh = 0.268;
+  for (double x : {0.0, 0.5, 1.0, 2.0})
+    for (double v : {0.3, 3.0}) {
+      h.tangential_damping = x;
+      const double K = h.k_n * std::sqrt(r);
+      // tsuji: alpha sqrt(m k_n a) d^0 = alpha sqrt(m k_n sqrt(r)) d^1/4
+      const double ref = direct_slip_rebound(mh, K, 1.5, h.damping_alpha * std::sqrt(mh * K), 0.25,
+                                             v, 2.0 / 7.0 * mh, h.k_t * std::sqrt(r), 0.5, x);
+      EXPECT_NEAR(tangential_restitution(h, mh, 2.0 / 7.0 * mh, r, v, 0.0), ref, 3e-3)
+          << "x " << x << " v " << v;
+    }
+  // the oblique impact (3 down, 2 along, mu 0.5): the spring slides at first (the grid's
+  // interpolation in chi is within 1e-2 there)
+  h.mu = 0.5;
+  for (double x : {0.0, 1.0, 2.0}) {
+    h.tangential_damping = x;
+    const double K = h.k_n * std::sqrt(r), m_t = 2.0 / 7.0 * mh;
+    const double ref = direct_slip_rebound(mh, K, 1.5, h.damping_alpha * std::sqrt(mh * K), 0.25,
+                                           3.0, m_t, h.k_t * std::sqrt(r), 0.5, x, 0.5, 2.0);
+    EXPECT_NEAR(tangential_restitution(h, mh, m_t, r, 3.0, 2.0), ref, 1e-2) << "x " << x;
+    if (x == 0) { // undamped, it would almost complete a swing in the collision if it stuck
+      EXPECT_GT(ref - tangential_restitution(h, mh, m_t, r, 3.0, 0.0), 1.0);
+    }
+  }
+  // LIGGGHTS's cone on the spring alone (its hertz: x 2 sqrt(G_eff / Y_eff), 1.2 here)
+  h.cone_on_spring = true;
+  h.tangential_damping = 1.2;
+  const double K_h = h.k_n * std::sqrt(r), m_th = 2.0 / 7.0 * mh;
+  const double g = h.damping_alpha * std::sqrt(mh * K_h);
+  const double spring_cone = direct_slip_rebound(mh, K_h, 1.5, g, 0.25, 3.0, m_th,
+                                                 h.k_t * std::sqrt(r), 0.5, 1.2, 0.5, 2.0, true);
+  EXPECT_NEAR(tangential_restitution(h, mh, m_th, r, 3.0, 2.0), spring_cone, 1e-2);
+  EXPECT_GT(std::abs(spring_cone - direct_slip_rebound(mh, K_h, 1.5, g, 0.25, 3.0, m_th,
+                                                       h.k_t * std::sqrt(r), 0.5, 1.2, 0.5, 2.0)),
+            0.05);
+  h.cone_on_spring = false;
+  h.damping_alpha = -1.0;
+  h.viscous = ViscousDamping::mass_velocity;
+  h.viscous_coeff = 500.0;
+  h.tangential_damping = 0.5;
+  for (double v : {0.3, 3.0})
+    EXPECT_NEAR(tangential_restitution(h, mh, 2.0 / 7.0 * mh, r, v, 0.0),
+                direct_slip_rebound(mh, h.k_n * std::sqrt(r), 1.5, 500.0 * mh, 0, v, 2.0 / 7.0 * mh,
+                                    h.k_t * std::sqrt(r), 0.5, 0.5),
+                3e-3)
+        << "v " << v;
+  // none without a tangential spring or with its dashpot unknown
+  h.tangential_damping = -1.0;
+  EXPECT_TRUE(std::isnan(tangential_restitution(h, mh, 2.0 / 7.0 * mh, r, 1.0, 0.0)));
+  h.tangential_damping = 0.5;
+  h.tangential = TangentialLaw::none;
+  EXPECT_TRUE(std::isnan(tangential_restitution(h, mh, 2.0 / 7.0 * mh, r, 1.0, 0.0)));
+}
+
+// An impact that closes within a step of at most 0.1 collision times takes the law's tangential
+// restitution on its slip; at longer steps, or with t_c unknown, it has none.
+TEST(Material, ImpactsTakeTheLawsTangentialRestitution)
+{
+  LoadedWallContact w;
+  w.p.tangential_damping = 1.0;
+  w.p.restitution = 0.3;
+  w.model.materials.at(1, 1) = w.p;
+  w.model.bounce_speed = 0.0;
+  w.contacts[0].gap = 1e-7;
+  w.contacts[0].point = Vec3(0, 0, -0.25);
+  w.bodies[0].v = Vec3(1.0, 0.0, -2.0);
+  Vector last = Vector::Constant(3, 0.0); // no load: an impact
+  const double t_c = 1e-3;
+  const auto e_t = [&](double h, double t) {
+    w.model.collision_time = t;
+    SpookParams params = step_of(h);
+    params.bounce_speed = 0.0;
+    apply_contact_model(w.model, params, 1.0, w.bodies, w.contacts, &last);
+    EXPECT_EQ(w.contacts[0].restitution, last[0] > 0 ? 0.0 : 0.3);
+    return w.contacts[0].tangential_restitution;
+  };
+  const double expected = tangential_restitution(w.p, 0.2, 2.0 / 7.0 * 0.2, 0.25, 2.0, 1.0);
+  ASSERT_TRUE(std::isfinite(expected));
+  EXPECT_NEAR(e_t(1e-5, t_c), expected, 1e-12);
+  EXPECT_TRUE(std::isnan(e_t(2e-4, t_c))); // 0.2 t_c a step
+  EXPECT_TRUE(std::isnan(e_t(1e-5, 0.0))); // t_c unknown
+  last[0] = 1e-6;                          // loaded in the last step: no impact
+  EXPECT_TRUE(std::isnan(e_t(1e-5, t_c)));
+}
+
 // The collision time of the elastic laws against the collision integrated by RK4 (m d'' = -F(d)
 // from d = 0 at the approach speed until the overlap closes again).
 TEST(Material, CollisionTimeOfTheElasticLaws)

@@ -8,6 +8,7 @@
 
 #include "fibre/algebra/kernels.hpp"
 #include "fibre/algebra/spook.hpp"
+#include "fibre/model/contact_model.hpp"
 #include "fibre/model/material.hpp"
 #include "fibre/scenes.hpp"
 #include "fibre/step/recovery.hpp"
@@ -750,6 +751,53 @@ TEST(ContactSolver, RestitutionHeadOnPair)
       }
     }
   }
+}
+
+// The tangential restitution of an impact (Contact::tangential_restitution): an oblique pair
+// (unequal masses and radii, closing within the step) leaves with its contact point's slip at
+// -e_t times its approach, the normal at -e, momentum kept; where the cone cannot hold that
+// impulse (mu 0.01) the slip changes by w_tt mu lambda_n, the cone's bound.
+TEST(ContactSolver, ObliqueImpactTakesTheTangentialRestitution)
+{
+  for (double mu : {0.5, 0.01})
+    for (double e_t : {-0.5, 0.0, 0.6, 1.0}) {
+      std::vector<Body> bodies{sphere(1.0, 1.0, Vec3(0, 0, 2.50001)),
+                               sphere(3.0, 1.5, Vec3::Zero())};
+      for (Body &b : bodies) b.force.setZero();
+      bodies[0].v = Vec3(0.7, -0.2, -2.0);
+      bodies[0].omega = Vec3(0.1, 0.3, 0.0);
+      bodies[1].v = Vec3(0.0, 0.1, 2.0 / 3.0);
+      std::vector<Contact> contacts{sphere_sphere_contact(bodies, 0, 1)};
+      Contact &c = contacts[0];
+      c.restitution = 0.5;
+      c.tangential_restitution = e_t;
+      c.friction.mu = mu;
+      c.compliance.fill(1e-14);
+      SpookParams p = spook();
+      p.bounce_speed = 0.1;
+      const Vec3 slip0 = relative_velocity(bodies, c);
+      const double vn0 = slip0.dot(c.normal);
+      const Vec3 ut0 = slip0 - vn0 * c.normal;
+      ContactSystem sys(bodies, contacts, 3, p);
+      SCOPED_TRACE("mu " + std::to_string(mu) + " e_t " + std::to_string(e_t));
+      const StepResult res = solve(sys, base_options());
+      for (int i = 0; i < 2; ++i) {
+        bodies[std::size_t(i)].v += res.dv.segment<3>(6 * i);
+        bodies[std::size_t(i)].omega += res.dv.segment<3>(6 * i + 3);
+      }
+      const Vec3 slip = relative_velocity(bodies, c);
+      const Vec3 ut = slip - slip.dot(c.normal) * c.normal;
+      EXPECT_NEAR(slip.dot(c.normal), -0.5 * vn0, 1e-6);
+      EXPECT_LT((res.dv.segment<3>(0) + 3.0 * res.dv.segment<3>(6)).norm(), 1e-12);
+      if (mu == 0.5) {
+        EXPECT_LT((ut + e_t * ut0).norm(), 1e-6 * ut0.norm());
+      } else { // sliding: the cone's impulse mu lambda_n along the slip
+        const double lambda_n = 1.5 * -vn0 / (1.0 + 1.0 / 3.0);
+        const double w_tt = 3.5 / 1.0 + 3.5 / 3.0;
+        EXPECT_NEAR((ut0 - ut).norm(), w_tt * mu * lambda_n, 1e-4 * w_tt * mu * lambda_n);
+        EXPECT_LT(ut.cross(ut0).norm(), 1e-6 * ut0.squaredNorm());
+      }
+    }
 }
 
 // Body-body contacts only: the impulses are internal, momentum and angular momentum stay.

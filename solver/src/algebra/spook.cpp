@@ -1,6 +1,7 @@
 #include "fibre/algebra/spook.hpp"
 
 #include <algorithm>
+#include <cmath>
 
 #include "fibre/algebra/cones.hpp"
 #include "fibre/algebra/kernels.hpp"
@@ -17,6 +18,21 @@ const Vector &start_rows(const ContactSystem &sys, Vector &own)
     return sys.velocity_rows();
   g_apply(sys, body_velocities(sys), own);
   return own;
+}
+
+// The rhs of tangential row r of contact k in the step its impact bounces: the slip vt leaves
+// at -e_t vt (Contact::tangential_restitution), asked as the normal row's jump is.
+double slip_rebound(const ContactSystem &sys, const Contact &k, Eigen::Index row, int r, double vt,
+                    double ups, double b)
+{
+  const Vec3 &t = r == 1 ? k.t1 : k.t2;
+  const auto weight = [&](int i) {
+    const Vec3 arm = (k.point - sys.bodies()[i].x).cross(t);
+    const double *w = &sys.inv_mass()[kBodyDofs * i];
+    return w[0] + arm[0] * arm[0] * w[3] + arm[1] * arm[1] * w[4] + arm[2] * arm[2] * w[5];
+  };
+  const double w_tt = weight(k.a) + (k.is_wall() ? 0.0 : weight(k.b)); // G_t M^-1 G_t^T
+  return (b - (ups + k.tangential_restitution) * vt) * (1.0 + sys.sigma()[row + r] / w_tt);
 }
 
 } // namespace
@@ -63,12 +79,6 @@ Vector spook_rhs(const ContactSystem &sys, const Vector *extra_dv)
     const std::array<double, kMaxRows> wall = wall_rows(k);
     if (k.wall_moves())
       for (int r = 0; r < rows; ++r) b[row + r] += (1.0 - ups_r[r]) * wall[r];
-    const int joint_rows = k.is_joint() ? 3 : 1; // a joint's t1, t2 carry its error
-    for (int r = 1; r < rows; ++r)
-      if ((k.elastic[r] || r < joint_rows) && sys.row_active(row + r))
-        b[row + r] += p.spring_term(k.spring[r], ups_r[r]);
-    if (!sys.row_active(row)) continue;
-    const double b_spook = b[row] + p.gap_term(k, ups_c);
     // Row: G_n v+ + eps lambda_n = G_n (v + h M^-1 f) + b_n, so b_n = 0 is free flight and
     // Newton's law G_n v+ = -e vn (vn = G_n v) is b_n = b_n(no gap) - (Upsilon + e) vn.
     // A contact that bounces keeps its approach speed until the step in which it closes:
@@ -76,7 +86,18 @@ Vector spook_rhs(const ContactSystem &sys, const Vector *extra_dv)
     const double vn = Gv.size() ? Gv[row] - wall[0] : 0.0; // relative normal velocity
     const double vn_free = ups_c * vn - b[row];            // the same after free flight
     const bool bounces = k.restitution > 0 && -vn > p.bounce_speed;
-    if (bounces && k.gap + p.h * vn_free <= 0) {
+    const bool impact = bounces && k.gap + p.h * vn_free <= 0 && sys.row_active(row);
+    const int joint_rows = k.is_joint() ? 3 : 1; // a joint's t1, t2 carry its error
+    for (int r = 1; r < rows; ++r) {
+      if (!sys.row_active(row + r)) continue;
+      if (impact && r <= 2 && !std::isnan(k.tangential_restitution))
+        b[row + r] = slip_rebound(sys, k, row, r, Gv[row + r] - wall[r], ups_r[r], b[row + r]);
+      else if (k.elastic[r] || r < joint_rows)
+        b[row + r] += p.spring_term(k.spring[r], ups_r[r]);
+    }
+    if (!sys.row_active(row)) continue;
+    const double b_spook = b[row] + p.gap_term(k, ups_c);
+    if (impact) {
       // The compliance would keep Sigma / (w + Sigma) of the jump, w = 1/m_a + 1/m_b the
       // row's G M^-1 G^T: ask for that much more (exact for an isolated contact).
       const double w_nn =

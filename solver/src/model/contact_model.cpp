@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "fibre/model/cohesion.hpp"
 
@@ -29,6 +30,11 @@ double effective_mass(const std::vector<Body> &bodies, const Contact &c)
 }
 
 } // namespace
+
+bool ContactModel::resolves_collisions(double h) const
+{
+  return collision_time > 0 && std::max(h, solve_step) <= kResolvedCollision * collision_time;
+}
 
 double normal_approach(const std::vector<Body> &bodies, const Contact &c)
 {
@@ -174,6 +180,25 @@ void impact_restitution(const ContactModel &model, const PairCoefficients &pc,
   }
 }
 
+// An impact that bounces within a step that resolves the collision: settled in that step, its
+// tangential rows would stop the slip (a Mindlin spring is rigid without a load, and a one-step
+// impact takes no dashpot), where the law's spring reverses it (doc/design.md, "Impacts at a
+// deck's step"). It takes the law's tangential restitution instead.
+void impact_slip(const PairCoefficients &pc, const SpookParams &params, double reff,
+                 const std::vector<Body> &bodies, Contact &c)
+{
+  const double approach = normal_approach(bodies, c);
+  if (!(c.restitution > 0 && approach > params.bounce_speed && c.gap <= params.h * approach))
+    return;
+  const Vec3 slip = relative_velocity(bodies, c);
+  const double u = (slip - slip.dot(c.normal) * c.normal).norm();
+  // the slip's reduced mass, 1 / m + r^2 / I of each solid sphere: 2/7 m_eff at any radii (one
+  // table per law, where the lever's length at each contact's overlap made one per contact)
+  const double m_eff = effective_mass(bodies, c);
+  c.tangential_restitution =
+      tangential_restitution(pc, m_eff, 2.0 / 7.0 * m_eff, reff, approach, u);
+}
+
 // compliance material's normal row of a contact without cohesion: its penetration and the
 // law's compliance at its overlap and last force.
 void elastic_row(const PairCoefficients &pc, const SpookParams &params, double reff, double overlap,
@@ -211,6 +236,8 @@ void apply_pair(const ContactModel &model, const PairCoefficients &pc, const Spo
   const bool cohesive = c.pull > 0;
   if (!model.typed.restitution && last_normal == 0)
     impact_restitution(model, pc, params, reff, bodies, c);
+  const bool resolved = model.resolves_collisions(h);
+  if (resolved && last_normal == 0) impact_slip(pc, params, reff, bodies, c);
   const int rows = model.rows;
   const double force = last_normal / h;
   if (cohesive) {
@@ -246,8 +273,6 @@ void apply_pair(const ContactModel &model, const PairCoefficients &pc, const Spo
   // and the law has a tangential dashpot (below).
   const double contact_d = std::max(model.damping, c.damping);
   const double floor = std::max(contact_d, critical);
-  const bool resolved = model.collision_time > 0 &&
-                        std::max(h, model.solve_step) <= kResolvedCollision * model.collision_time;
   for (int r = 1; r <= 2 && r < rows; ++r) {
     if (!c.elastic[r]) continue;
     // At a step that resolves the collisions, a law's own tangential dashpot, at least SPOOK's
@@ -320,6 +345,7 @@ void apply_contact_model(const ContactModel &model, const SpookParams &params, d
     }
     c.friction = model.friction;
     c.restitution = model.restitution;
+    c.tangential_restitution = std::numeric_limits<double>::quiet_NaN();
     c.elastic.fill(false);
     c.implicit_normal = false;
     c.damping = -1.0;

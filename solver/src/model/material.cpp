@@ -66,6 +66,7 @@ std::string MaterialTable::mix()
       p.cohesion_energy = geom(a.cohesion_energy, b.cohesion_energy);
       p.normal = a.normal;
       p.tangential = a.tangential;
+      p.cone_on_spring = a.cone_on_spring;
       p.k_n = stiff(a.k_n, b.k_n);
       p.k_t = stiff(a.k_t, b.k_t);
       p.k_roll = geom(a.k_roll, b.k_roll);

@@ -9,6 +9,7 @@
 #include <array>
 #include <cmath>
 #include <cstdint>
+#include <limits>
 #include <utility>
 #include <vector>
 
@@ -58,6 +59,10 @@ struct Contact {
   // Newton's impact law on the normal row: a contact that closes within the step at a speed
   // above SpookParams::bounce_speed separates at restitution times that speed. 0: plastic.
   double restitution = 0.0;
+  // The law's tangential restitution (tangential_restitution), where the step resolves the
+  // collision: in the step in which it bounces, the impact's slip leaves at minus this times
+  // its approach, within the cone. NaN: none (the tangential rows' SPOOK target).
+  double tangential_restitution = std::numeric_limits<double>::quiet_NaN();
   // A wall contact's partner type for per-type coefficients: an obstacle atom's type, or 0
   // for a wall (which takes the sphere's type).
   int wall_type = 0;

@@ -77,10 +77,12 @@ struct ContactModel {
   double substep_collisions = 0.33;
   // The law's shortest collision time at 1 velocity unit (the front end sets it each step, as
   // substeps auto reads it), 0: unknown, and the contact solve's step before its substeps (0:
-  // the step's). A solve's step of at most kResolvedCollision of it resolves the collisions,
-  // and the tangential springs take the law's dashpot (apply_pair).
+  // the step's). A solve's step of at most kResolvedCollision of it resolves the collisions:
+  // the tangential springs take the law's dashpot and impacts its tangential restitution
+  // (apply_pair).
   double collision_time = 0.0;
   double solve_step = 0.0;
+  bool resolves_collisions(double h) const;
   // Whether a step in which no contact moves (step_moves: a pile at rest) takes one solve
   // instead of its substeps (keyword substep_when moving; always, the default: every step).
   bool substep_moving_only = false;

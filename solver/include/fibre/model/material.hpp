@@ -64,6 +64,9 @@ struct PairCoefficients {
   // gran/*'s gamma_t / gamma_n: 0 with dampflag 0); < 0: not known, the tangential rows take
   // the normal row's damping (tangential_damper_time).
   double tangential_damping = -1.0;
+  // LIGGGHTS's tangential history: its cone bounds the spring's force alone, and a sliding
+  // contact has no tangential dashpot (LAMMPS's bounds the spring and dashpot together).
+  bool cone_on_spring = false;
   // LIGGGHTS's hooke: the stiffnesses of each contact follow from its effective Young's
   // modulus and the deck's characteristicVelocity v_c (> 0), k_n = 16/15 sqrt(r_eff) Y_eff (15
   // m_eff v_c^2 / (16 sqrt(r_eff) Y_eff))^(1/5) and k_t = k_n (contact_law); k_n and k_t are
@@ -185,6 +188,19 @@ double normal_damper(const PairCoefficients &p, double m_eff, double a, double k
 // The damping time b_t / k_t of the tangential spring k_t = 1 / eps_t, its dashpot b_t the
 // law's tangential_damping times the normal dashpot gamma_n (>= 0); < 0 where either is unknown.
 double tangential_damper_time(const PairCoefficients &p, double gamma_n, double eps_t);
+
+// The tangential coefficient of restitution of an impact at approach speed v and slip speed u
+// (the contact point's, along the contact plane): e_t = -u+ / u after the pair's tangential
+// spring (linear k_t or Mindlin's k_t a) and dashpot (tangential_damping times the normal one)
+// have acted over the normal law's collision within the cone mu |F_n|, a spring beyond it set
+// back to it, as LAMMPS's history is (Maw, Barber and Fawcett's impact). It depends on the
+// impact's angle through chi = mu m_eff v / (m_t u); u = 0 sticks. m_t is the slip's reduced
+// mass, 2/7 m_eff for two solid spheres. From 1 (an undamped spring as fast as the normal one
+// reverses a slip that sticks) to -1; NaN where the law has no tangential spring, its dashpot
+// is unknown or the overlap never closes. Integrated on a grid of the law's normal damping and
+// chi, each point on first use, and interpolated.
+double tangential_restitution(const PairCoefficients &p, double m_eff, double m_t, double r_eff,
+                              double v, double u);
 
 // The damping time (seconds) of row r's spring in the pair's law, gamma / k of the SDS rolling
 // (rows 4, 5) and twisting (row 3) laws; 0 where the law has no damper of its own.
