@@ -360,6 +360,15 @@ PairCoefficients hertz_material_pair()
 }
 const std::array<double, kMaxRows> kRigid = {1e-9, 2e-9, 2e-9, 3e-9, 4e-9, 4e-9};
 
+// Hooke's normal law with a linear tangential spring, its constants unset
+PairCoefficients linear_hooke_pair()
+{
+  PairCoefficients p;
+  p.normal = NormalLaw::hooke;
+  p.tangential = TangentialLaw::linear;
+  return p;
+}
+
 } // namespace
 
 TEST(Material, SecantComplianceOfTheNormalLaw)
@@ -741,9 +750,7 @@ double direct_slip_rebound(double m, double K, double p, double g, double q, dou
 // and gran/hertz/history's mass_velocity against a direct integration in the deck's units.
 TEST(Material, TangentialReboundOfTheLaw)
 {
-  PairCoefficients p;
-  p.normal = NormalLaw::hooke;
-  p.tangential = TangentialLaw::linear;
+  PairCoefficients p = linear_hooke_pair();
   p.k_n = 2000.0;
   p.tangential_damping = 0.0;
   const double m = 0.5, m_t = 2.0 / 7.0 * m;
@@ -995,9 +1002,7 @@ TEST(Material, WallCurvatureGivesTheEffectiveRadius)
 // its collision time pi sqrt(m_eff / k_n); a table entry without v_c is returned as it is.
 TEST(Material, LiggghtsHookeStiffnessPerContact)
 {
-  PairCoefficients p;
-  p.normal = NormalLaw::hooke;
-  p.tangential = TangentialLaw::linear;
+  PairCoefficients p = linear_hooke_pair();
   p.hooke_y_eff = 3e6;
   p.hooke_velocity = 2.0;
   const double m = 0.0013, r = 0.004;
