@@ -16,9 +16,9 @@ Both twins run with lmp_fibre (lmp plus the fix) through examples/official/offic
   the law's dashpot, floored at 5 steps, 16.5% below serially and 9.1% on two processes).
 - granregion.funnel (gran/hertz/history grains poured into a cone and cylinder, a union region
   wall, held on a plug, then discharged through the bottom once the plug's region is redefined
-  and the fix defined again; shortened to 400 grains at four times the step): no grain lost
-  while the plug holds, and the discharge rate within 25% of native's (native's own spread over
-  six seeds is 8%; examples/official/README.md).
+  and the fix defined again; shortened to 400 grains at four times the step), over four seeds
+  of its fix pour: no grain lost while the plug holds, and the mean discharge rate within 15%
+  of native's mean (one seed's rate is chaotic; examples/official/README.md).
 - pour again with contact_every auto (the contacts solved every 5 steps, over those 5):
   every sphere kept and the flow's kinetic energy within 10% of native's (on two processes,
   of the serial run's).
@@ -121,24 +121,52 @@ def main():
                      tag + "the flow's mean rotational energy within 20% of native",
                      "%s vs %s" % (ff.get("rke"), fn.get("rke")))
             every = every_auto(ck, official, args, np, fn, every)
-        tag = "granregion.funnel np %d: " % np
-        funnel = twins(ck, official, args, "granregion.funnel", np)
-        if funnel:
-            fn, ff, output = funnel
-            ck.check(ff.get("filled") == ff.get("settled") == fn.get("settled") == 400,
-                     tag + "no grain lost while the plug holds",
-                     "fix %s %s, native %s" % (ff.get("filled"), ff.get("settled"),
-                                               fn.get("settled")))
-            ck.check(ff.get("left", 400) < 200 and fn.get("left", 400) < 200,
-                     tag + "most grains discharged once the plug is gone",
-                     "left: fix %s, native %s" % (ff.get("left"), fn.get("left")))
-            ck.check(e2e.rel_err(ff.get("rate", 0), fn.get("rate", 1)) < 0.25,
-                     tag + "the discharge rate within 25% of native",
-                     "%s vs %s" % (ff.get("rate"), fn.get("rate")))
+        funnel_seeds(ck, official, args, np)
         drum_intended(ck, official, args, np)
     for np in (1, 2):
         mixer_every(ck, official, args, np)
     ck.close()
+
+
+FUNNEL_SEEDS = (42424, 11111, 22222, 33333)  # the deck's own seed of its fix pour first
+
+
+def funnel_seeds(ck, official, args, np):
+    """The shortened funnel over FUNNEL_SEEDS on np processes: no grain lost while the plug
+    holds, most discharged, and the mean discharge rate within 15% of native's mean (one
+    seed's rate is chaotic: over six, native's spread is 8% and the fix's 10%, so the
+    difference of two four-seed means has a standard deviation near 6.5%)."""
+    tag = "granregion.funnel np %d: " % np
+    name = "granregion.funnel"
+    rates = {"native": [], "fibre": []}
+    for seed in FUNNEL_SEEDS:
+        wd = os.path.join(args.workdir, "np%d" % np, "seed%d" % seed)
+        figures = {}
+        for twin, text in (("native", official.native_text(name)),
+                           ("fibre", official.fibre_text(name))):
+            text = official.shortened(name, text)
+            if not ck.check("pour 400 1 42424" in text, tag + "the deck's fix pour line found"):
+                return
+            text = text.replace("pour 400 1 42424", "pour 400 1 %d" % seed)
+            run = official.run_deck(args.lmp, text, wd, name + "." + twin, np, args.mpirun)
+            if not ck.check(run["rc"] == 0, tag + "seed %d: the %s twin runs" % (seed, twin),
+                            "rc %d" % run["rc"]):
+                return
+            figures[twin] = official.figures(name, run)
+            rates[twin].append(figures[twin].get("rate", 0))
+        fn, ff = figures["native"], figures["fibre"]
+        ck.check(ff.get("filled") == ff.get("settled") == fn.get("settled") == 400,
+                 tag + "seed %d: no grain lost while the plug holds" % seed,
+                 "fix %s %s, native %s" % (ff.get("filled"), ff.get("settled"), fn.get("settled")))
+        ck.check(ff.get("left", 400) < 200 and fn.get("left", 400) < 200,
+                 tag + "seed %d: most grains discharged once the plug is gone" % seed,
+                 "left: fix %s, native %s" % (ff.get("left"), fn.get("left")))
+    fix, native = (sum(rates[t]) / len(rates[t]) for t in ("fibre", "native"))
+    ck.check(e2e.rel_err(fix, native) < 0.15,
+             tag + "the mean discharge rate over %d seeds within 15%% of native's"
+             % len(FUNNEL_SEEDS), "%.4g vs %.4g (fix %s, native %s)"
+             % (fix, native, ["%.1f" % r for r in rates["fibre"]],
+                ["%.1f" % r for r in rates["native"]]))
 
 
 def drum_intended(ck, official, args, np):
@@ -181,7 +209,8 @@ def mixer_every(ck, official, args, np):
     ck.check(e2e.rel_err(ff.get("zc", 0), fn.get("zc", 1)) < 0.10,
              tag + "the bed centre within 10% of native", "%s vs %s" % (ff.get("zc"), fn.get("zc")))
     ck.check(e2e.rel_err(ff.get("ke", 0), fn.get("ke", 1)) < 0.20,
-             tag + "the kinetic energy within 20% of native", "%s vs %s" % (ff.get("ke"), fn.get("ke")))
+             tag + "the kinetic energy within 20% of native",
+             "%s vs %s" % (ff.get("ke"), fn.get("ke")))
 
 
 if __name__ == "__main__":
